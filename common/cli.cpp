@@ -1,0 +1,145 @@
+#include "common/cli.h"
+
+#include <omp.h>
+
+#include <cstdio>
+#include <new>
+#include <sstream>
+
+#include "common/atomic_file.h"
+#include "common/errors.h"
+
+namespace voroudf {
+namespace {
+
+std::string OneLine(std::string s) {
+  for (char& c : s)
+    if (c == '\n' || c == '\r') c = ' ';
+  return s;
+}
+
+std::string Quoted(const std::string& s) {
+  if (!s.empty() && s.find_first_of(" \t'\"$;&|<>()") == std::string::npos) return s;
+  std::string q = "'";
+  for (char c : s) q += (c == '\'') ? std::string("'\\''") : std::string(1, c);
+  return q + "'";
+}
+
+}  // namespace
+
+StageCli::StageCli(std::string program, std::string description)
+    : program_(std::move(program)), app_(std::move(description), program_) {
+  app_.option_defaults()->always_capture_default();
+  app_.get_formatter()->column_width(34);
+  app_.add_option("--threads", threads_, "worker threads (0: all cores)")->check(CLI::NonNegativeNumber);
+  app_.add_flag("-v,--verbose", verbose_, "log details (debug level)");
+  app_.add_flag("-q,--quiet", quiet_, "log errors only");
+  non_semantic_ = {"--threads", "--verbose", "--quiet", "--help", "--output", "--input"};
+}
+
+CLI::Option* StageCli::AddInput(std::string* path, const std::string& description) {
+  return app_.add_option("-i,--input", *path, description)->required();
+}
+
+CLI::Option* StageCli::AddOutput(std::string* path, const std::string& description) {
+  outputs_.push_back(path);
+  return app_.add_option("-o,--output", *path, description)->required();
+}
+
+CLI::Option* StageCli::AddExtraOutput(const std::string& flag, std::string* path, const std::string& description) {
+  outputs_.push_back(path);
+  CLI::Option* opt = app_.add_option(flag, *path, description);
+  non_semantic_.insert(opt->get_name());
+  return opt;
+}
+
+CLI::Option* StageCli::AddUdf(std::string* spec) {
+  udf_spec_ = spec;
+  CLI::Option* opt = app_.add_option(
+      "--udf", *spec,
+      "UDF source: shape:NAME (sphere cube disc hemisphere crossing-planes sphere-disc three-discs torus), "
+      "a mesh .obj/.off/.ply/.stl, a grid .npy, or exec:COMMAND");
+  opt->required();
+  app_.add_option("--udf-box", udf_options_.grid_box, "domain box of a .npy grid: xmin,ymin,zmin,xmax,ymax,zmax");
+  app_.add_option("--udf-timeout", udf_options_.exec_timeout_s, "seconds to wait for an exec: source's answer")
+      ->check(CLI::PositiveNumber);
+  non_semantic_.insert("--udf-timeout");
+  non_semantic_.insert("--udf");  // recorded on its own provenance line
+  return opt;
+}
+
+CLI::Option* StageCli::AddSeed(uint64_t* seed) {
+  return app_.add_option("--seed", *seed, "seed of the random number generator");
+}
+
+CLI::Option* StageCli::AddAscii(bool* ascii) {
+  CLI::Option* opt = app_.add_flag("--ascii", *ascii, "write PLY output as ASCII (default: binary little-endian)");
+  non_semantic_.insert("--ascii");
+  return opt;
+}
+
+std::string StageCli::EffectiveOptions(bool semantic_only) const {
+  std::ostringstream out;
+  bool first = true;
+  for (const CLI::Option* opt : app_.get_options()) {
+    if (!opt->nonpositional()) continue;
+    const std::string name = opt->get_name();
+    if (name == "--help" || (semantic_only && non_semantic_.count(name))) continue;
+    const bool is_flag = opt->get_type_size_max() == 0;
+    std::string value;
+    if (opt->count() > 0) {
+      for (const auto& r : opt->results()) value += (value.empty() ? "" : " ") + Quoted(r);
+    } else {
+      value = opt->get_default_str();
+    }
+    if (is_flag) {
+      if (opt->count() == 0) continue;
+      value.clear();
+    } else if (value.empty()) {
+      continue;
+    }
+    out << (first ? "" : " ") << name << (value.empty() ? "" : " " + value);
+    first = false;
+  }
+  return out.str();
+}
+
+Provenance StageCli::provenance() const {
+  return Provenance{program_, EffectiveOptions(true), udf_spec_ ? *udf_spec_ : std::string()};
+}
+
+int StageCli::Run(int argc, char** argv, const std::function<void()>& check,
+                  const std::function<void(Monitor&)>& body) {
+  try {
+    app_.parse(argc, argv);
+  } catch (const CLI::Success& e) {
+    return app_.exit(e);  // --help: prints the help, exit code 0
+  } catch (const CLI::ParseError& e) {
+    std::fprintf(stderr, "%s: error: %s (see %s --help)\n", program_.c_str(), OneLine(e.what()).c_str(),
+                 program_.c_str());
+    return kExitUsage;
+  }
+  InstallTemporaryFileCleanup();
+  if (threads_ > 0) omp_set_num_threads(threads_);
+  StderrMonitor monitor(program_, quiet_ ? LogLevel::kError : verbose_ ? LogLevel::kDebug : LogLevel::kInfo);
+  try {
+    check();
+    for (const std::string* out : outputs_)
+      if (!out->empty()) CheckWritable(*out);
+    monitor.Info(program_ + " " + EffectiveOptions(false) + "  [" + std::to_string(omp_get_max_threads()) +
+                 " threads]");
+    body(monitor);
+    return kExitOk;
+  } catch (const Error& e) {
+    std::fprintf(stderr, "%s: error: %s\n", program_.c_str(), OneLine(e.what()).c_str());
+    return e.exit_code();
+  } catch (const std::bad_alloc&) {
+    std::fprintf(stderr, "%s: error: out of memory\n", program_.c_str());
+    return kExitFailure;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "%s: error: internal: %s\n", program_.c_str(), OneLine(e.what()).c_str());
+    return kExitFailure;
+  }
+}
+
+}  // namespace voroudf

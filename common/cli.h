@@ -1,0 +1,62 @@
+#pragma once
+// Program conventions shared by every stage (docs/conventions.md): CLI11 options with generated --help,
+// long kebab-case flags, -i/-o/--udf/--seed/--threads/-v/-q, the echo of the effective options, logs and
+// progress on stderr, and one top-level handler that turns typed errors into one line and an exit code.
+#include <CLI/CLI.hpp>
+
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "common/monitor.h"
+#include "common/provenance.h"
+#include "common/udf_spec.h"
+
+namespace voroudf {
+
+class StageCli {
+ public:
+  StageCli(std::string program, std::string description);
+
+  CLI::App& app() { return app_; }
+
+  /// -i/--input (required).
+  CLI::Option* AddInput(std::string* path, const std::string& description);
+  /// -o/--output (required); checked for writability before any work starts.
+  CLI::Option* AddOutput(std::string* path, const std::string& description);
+  /// An extra optional output file (e.g. --labels); checked like -o when given.
+  CLI::Option* AddExtraOutput(const std::string& flag, std::string* path, const std::string& description);
+  /// --udf SPEC (required) plus the source options --udf-box and --udf-timeout.
+  CLI::Option* AddUdf(std::string* spec);
+  /// --seed for the random number generator.
+  CLI::Option* AddSeed(uint64_t* seed);
+  /// --ascii: write PLY as ASCII instead of binary little-endian.
+  CLI::Option* AddAscii(bool* ascii);
+
+  const UdfSourceOptions& udf_options() const { return udf_options_; }
+
+  /// Provenance for output headers: the program, its result-changing options and the UDF SPEC.
+  Provenance provenance() const;
+
+  /// Parses argv; sets threads and verbosity; runs `check` (option validation, may throw UsageError);
+  /// checks outputs are writable; echoes the effective options; runs `body`. Returns the exit code.
+  int Run(int argc, char** argv, const std::function<void()>& check, const std::function<void(Monitor&)>& body);
+
+ private:
+  std::string EffectiveOptions(bool semantic_only) const;
+
+  std::string program_;
+  CLI::App app_;
+  int threads_ = 0;
+  bool verbose_ = false;
+  bool quiet_ = false;
+  std::string* udf_spec_ = nullptr;
+  UdfSourceOptions udf_options_;
+  std::vector<std::string*> outputs_;
+  std::set<std::string> non_semantic_;  ///< options that do not change results (left out of provenance)
+};
+
+}  // namespace voroudf

@@ -1,0 +1,229 @@
+#include "common/shapes.h"
+
+#include <algorithm>
+#include <cmath>
+#include <functional>
+
+#include "common/errors.h"
+
+namespace voroudf {
+namespace {
+
+// Below this length a direction is undefined; the shapes are unit-sized so an absolute value is right.
+constexpr double kTiny = 1e-12;
+
+// Any unit vector orthogonal to n (deterministic).
+Vec3 AnyOrthogonal(const Vec3& n) {
+  const Vec3 a = std::abs(n.x()) < 0.9 ? Vec3::UnitX() : Vec3::UnitY();
+  return n.cross(a).normalized();
+}
+
+class Sphere : public Primitive {
+ public:
+  Sphere(const Vec3& c, double r) : c_(c), r_(r) {}
+  Vec3 ClosestPoint(const Vec3& p, Vec3* normal) const override {
+    const Vec3 v = p - c_;
+    const double len = v.norm();
+    *normal = len > kTiny ? Vec3(v / len) : Vec3::UnitZ();
+    return c_ + r_ * *normal;
+  }
+
+ private:
+  Vec3 c_;
+  double r_;
+};
+
+class Hemisphere : public Primitive {
+ public:
+  Hemisphere(const Vec3& c, double r, const Vec3& axis) : c_(c), r_(r), axis_(axis.normalized()) {}
+  Vec3 ClosestPoint(const Vec3& p, Vec3* normal) const override {
+    const Vec3 v = p - c_;
+    const double h = v.dot(axis_);
+    const double len = v.norm();
+    if (h >= 0.0) {
+      *normal = len > kTiny ? Vec3(v / len) : axis_;
+    } else {
+      // Below the cut plane the closest point is on the rim, in the direction of v's in-plane part
+      // (maximising a linear function over a spherical cap whose pole is not in it).
+      const Vec3 in_plane = v - h * axis_;
+      const double l = in_plane.norm();
+      *normal = l > kTiny ? Vec3(in_plane / l) : AnyOrthogonal(axis_);
+    }
+    return c_ + r_ * *normal;
+  }
+
+ private:
+  Vec3 c_;
+  double r_;
+  Vec3 axis_;
+};
+
+class Disc : public Primitive {
+ public:
+  Disc(const Vec3& c, const Vec3& n, double r) : c_(c), n_(n.normalized()), r_(r) {}
+  Vec3 ClosestPoint(const Vec3& p, Vec3* normal) const override {
+    const Vec3 v = p - c_;
+    Vec3 in_plane = v - v.dot(n_) * n_;
+    const double l = in_plane.norm();
+    if (l > r_) in_plane *= r_ / l;
+    *normal = n_;
+    return c_ + in_plane;
+  }
+
+ private:
+  Vec3 c_, n_;
+  double r_;
+};
+
+class Rectangle : public Primitive {
+ public:
+  Rectangle(const Vec3& c, const Vec3& u, const Vec3& v, double hu, double hv)
+      : c_(c), u_(u.normalized()), v_(v.normalized()), n_(u_.cross(v_).normalized()), hu_(hu), hv_(hv) {}
+  Vec3 ClosestPoint(const Vec3& p, Vec3* normal) const override {
+    const Vec3 w = p - c_;
+    const double a = std::clamp(w.dot(u_), -hu_, hu_);
+    const double b = std::clamp(w.dot(v_), -hv_, hv_);
+    *normal = n_;
+    return c_ + a * u_ + b * v_;
+  }
+
+ private:
+  Vec3 c_, u_, v_, n_;
+  double hu_, hv_;
+};
+
+class CubeSurface : public Primitive {
+ public:
+  explicit CubeSurface(double h) : h_(h) {}
+  Vec3 ClosestPoint(const Vec3& p, Vec3* normal) const override {
+    // The face whose plane is nearest to p: largest |p_k| (first on ties).
+    int k = 0;
+    for (int i = 1; i < 3; ++i)
+      if (std::abs(p[i]) > std::abs(p[k])) k = i;
+    const double s = p[k] < 0.0 ? -1.0 : 1.0;
+    *normal = s * Vec3::Unit(k);
+    Vec3 c;
+    if ((p.array().abs() <= h_).all()) {
+      c = p;  // inside: push the dominant coordinate onto its face
+      c[k] = s * h_;
+    } else {
+      c = p.cwiseMax(-h_).cwiseMin(h_);
+    }
+    return c;
+  }
+
+ private:
+  double h_;
+};
+
+class Torus : public Primitive {
+ public:
+  Torus(double R, double r) : R_(R), r_(r) {}
+  Vec3 ClosestPoint(const Vec3& p, Vec3* normal) const override {
+    const double rho = std::hypot(p.x(), p.y());
+    const Vec3 radial = rho > kTiny ? Vec3(p.x() / rho, p.y() / rho, 0.0) : Vec3::UnitX();
+    const Vec3 m = R_ * radial;  // nearest point of the core circle
+    const Vec3 v = p - m;
+    const double l = v.norm();
+    *normal = l > kTiny ? Vec3(v / l) : radial;
+    return m + r_ * *normal;
+  }
+
+ private:
+  double R_, r_;
+};
+
+}  // namespace
+
+std::unique_ptr<Primitive> MakeSphere(const Vec3& c, double r) { return std::make_unique<Sphere>(c, r); }
+std::unique_ptr<Primitive> MakeHemisphere(const Vec3& c, double r, const Vec3& axis) {
+  return std::make_unique<Hemisphere>(c, r, axis);
+}
+std::unique_ptr<Primitive> MakeDisc(const Vec3& c, const Vec3& n, double r) { return std::make_unique<Disc>(c, n, r); }
+std::unique_ptr<Primitive> MakeRectangle(const Vec3& c, const Vec3& u, const Vec3& v, double hu, double hv) {
+  return std::make_unique<Rectangle>(c, u, v, hu, hv);
+}
+std::unique_ptr<Primitive> MakeCubeSurface(double h) { return std::make_unique<CubeSurface>(h); }
+std::unique_ptr<Primitive> MakeTorus(double R, double r) { return std::make_unique<Torus>(R, r); }
+
+AnalyticUdf::AnalyticUdf(std::string name, std::string description, Box domain,
+                         std::vector<std::unique_ptr<Primitive>> parts)
+    : name_(std::move(name)), description_(std::move(description)), domain_(domain), parts_(std::move(parts)) {}
+
+void AnalyticUdf::EvaluateChunk(const Vec3* points, size_t count, double* distance, Vec3* gradient) const {
+  for (size_t i = 0; i < count; ++i) {
+    const Vec3& p = points[i];
+    double best = INFINITY;
+    Vec3 best_c = p, best_n = Vec3::UnitZ();
+    for (const auto& part : parts_) {
+      Vec3 n;
+      const Vec3 c = part->ClosestPoint(p, &n);
+      const double d = (p - c).norm();
+      if (d < best) {
+        best = d;
+        best_c = c;
+        best_n = n;
+      }
+    }
+    distance[i] = best;
+    gradient[i] = best > kTiny ? Vec3((p - best_c) / best) : best_n;
+  }
+}
+
+std::string AnalyticUdf::Describe() const { return "shape:" + name_ + " (" + description_ + ")"; }
+
+namespace {
+
+struct ShapeEntry {
+  const char* name;
+  const char* description;
+  std::function<std::vector<std::unique_ptr<Primitive>>()> build;
+};
+
+template <typename... P>
+std::vector<std::unique_ptr<Primitive>> Parts(P&&... p) {
+  std::vector<std::unique_ptr<Primitive>> v;
+  (v.push_back(std::forward<P>(p)), ...);
+  return v;
+}
+
+const std::vector<ShapeEntry>& Shapes() {
+  const Vec3 o = Vec3::Zero(), x = Vec3::UnitX(), y = Vec3::UnitY(), z = Vec3::UnitZ();
+  static const std::vector<ShapeEntry> shapes = {
+      {"sphere", "sphere of radius 0.5 at the origin", [=] { return Parts(MakeSphere(o, 0.5)); }},
+      {"cube", "surface of the cube [-0.5,0.5]^3: 12 sharp edges, 8 corners",
+       [=] { return Parts(MakeCubeSurface(0.5)); }},
+      {"disc", "open disc of radius 0.5 in the plane z=0", [=] { return Parts(MakeDisc(o, z, 0.5)); }},
+      {"hemisphere", "open upper hemisphere (z>=0) of the sphere of radius 0.5",
+       [=] { return Parts(MakeHemisphere(o, 0.5, z)); }},
+      {"crossing-planes", "squares [-0.5,0.5]^2 in z=0 and x=0 crossing along the y axis (non-manifold line)",
+       [=] { return Parts(MakeRectangle(o, x, y, 0.5, 0.5), MakeRectangle(o, y, z, 0.5, 0.5)); }},
+      {"sphere-disc", "sphere of radius 0.5 with the disc z=0 inside it (non-manifold equator)",
+       [=] { return Parts(MakeSphere(o, 0.5), MakeDisc(o, z, 0.5)); }},
+      {"three-discs", "discs of radius 0.5 in the planes x=0, y=0, z=0 (non-manifold axes)",
+       [=] { return Parts(MakeDisc(o, z, 0.5), MakeDisc(o, x, 0.5), MakeDisc(o, y, 0.5)); }},
+      {"torus", "torus around z, radii 0.35 and 0.15 (genus 1)", [=] { return Parts(MakeTorus(0.35, 0.15)); }},
+  };
+  return shapes;
+}
+
+}  // namespace
+
+std::vector<std::pair<std::string, std::string>> ShapeCatalog() {
+  std::vector<std::pair<std::string, std::string>> out;
+  for (const auto& s : Shapes()) out.emplace_back(s.name, s.description);
+  return out;
+}
+
+std::unique_ptr<AnalyticUdf> MakeShape(const std::string& name) {
+  // Every shape lies in [-0.5,0.5]^3; one common domain keeps relative lengths comparable across shapes.
+  const Box domain{Vec3::Constant(-0.6), Vec3::Constant(0.6)};
+  std::string known;
+  for (const auto& s : Shapes()) {
+    if (name == s.name) return std::make_unique<AnalyticUdf>(s.name, s.description, domain, s.build());
+    known += std::string(known.empty() ? "" : ", ") + s.name;
+  }
+  throw InputError("shape:" + name, "unknown built-in shape (known: " + known + ")");
+}
+
+}  // namespace voroudf

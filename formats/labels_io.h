@@ -1,0 +1,27 @@
+#pragma once
+// Labelled samples of the geodesic Voronoi diagram (docs/formats.md): PLY `vertex` with float x y z,
+// int label (seed index, -1 unreached), float dist (geodesic), and optionally an `edge` element with
+// int vertex1 vertex2 (the pruned kNN graph).
+#include <array>
+#include <string>
+#include <vector>
+
+#include "common/provenance.h"
+#include "common/types.h"
+
+namespace voroudf {
+
+struct LabeledSamples {
+  std::vector<Vec3> position;
+  std::vector<int> label;
+  std::vector<double> dist;
+  std::vector<std::array<int, 2>> edges;  ///< optional graph
+
+  size_t size() const { return position.size(); }
+};
+
+LabeledSamples ReadLabels(const std::string& path);
+void WriteLabels(const std::string& path, const LabeledSamples& samples, const Provenance& provenance,
+                 bool ascii = false);
+
+}  // namespace voroudf

@@ -1,0 +1,32 @@
+#!/usr/bin/env bash
+# Installs the Debian packages voroudf needs (only those missing; --no-install-recommends; sudo when not
+# root) and builds it in build/ (Release). Sourced or run by demo.sh and test.sh.
+# Extra CMake arguments: VOROUDF_CMAKE_ARGS="-DVOROUDF_WERROR=ON" (CI sets this).
+set -euo pipefail
+ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+
+PACKAGES=(
+  build-essential cmake              # compiler, make, cmake
+  libeigen3-dev libcli11-dev libgtest-dev
+  libceres-dev                       # L-BFGS (optimize-seeds)
+  libpcl-dev                         # neighbour search (optimize-seeds)
+  libflann-dev                       # kNN graphs (build-gvd)
+  libopenmesh-dev libcgal-dev        # manifold mesh work, exact predicates
+  python3-numpy snakemake            # exec: reference server, Snakefile
+)
+
+missing=()
+for p in "${PACKAGES[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if ((${#missing[@]})); then
+  SUDO=""
+  if [ "$(id -u)" -ne 0 ]; then SUDO=sudo; fi
+  echo "voroudf setup: installing ${missing[*]}" >&2
+  $SUDO env DEBIAN_FRONTEND=noninteractive apt-get update -qq
+  $SUDO env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends "${missing[@]}" >&2
+fi
+
+# shellcheck disable=SC2086  # VOROUDF_CMAKE_ARGS is a list of arguments
+cmake -S "$ROOT" -B "$ROOT/build" -DCMAKE_BUILD_TYPE=Release ${VOROUDF_CMAKE_ARGS:-} >&2
+cmake --build "$ROOT/build" -j"$(nproc)" >&2

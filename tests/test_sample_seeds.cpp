@@ -1,0 +1,142 @@
+// sample-seeds: the library on every built-in shape, and the real executable end to end.
+#include <gtest/gtest.h>
+
+#include "common/errors.h"
+#include "common/shapes.h"
+#include "formats/seeds_io.h"
+#include "stages/sample-seeds/sample_seeds.h"
+#include "tests/support/test_support.h"
+
+namespace voroudf {
+namespace {
+
+using test::RunProgram;
+using test::TempDir;
+
+const char* kShapes[] = {"sphere", "cube", "disc", "hemisphere", "crossing-planes", "sphere-disc", "three-discs", "torus"};
+
+TEST(SampleSeeds, EverySeedIsOnTheSurfaceForEveryShape) {
+  for (const char* name : kShapes) {
+    const auto udf = MakeShape(name);
+    SampleSeedsOptions options;
+    options.count = 400;
+    options.seed = 11;
+    const SeedCloud seeds = SampleSeeds(*udf, options, Monitor::Null());
+    // Exact fields project in one step: nothing is dropped.
+    EXPECT_EQ(seeds.size(), options.count) << name;
+    const double tol = options.proj_tol_rel * udf->Domain().Diagonal();
+    for (size_t i = 0; i < seeds.size(); ++i) {
+      EXPECT_LT(udf->Distance(seeds.position[i]), tol) << name << " seed " << i;
+      EXPECT_NEAR(seeds.normal[i].norm(), 1.0, 1e-9);
+      EXPECT_EQ(seeds.rank[i], kRankUnknown);
+    }
+  }
+}
+
+TEST(SampleSeeds, SeedsCoverTheWholeSurface) {
+  // Uniform draws projected onto the sphere: every octant gets seeds.
+  const auto udf = MakeShape("sphere");
+  SampleSeedsOptions options;
+  options.count = 800;
+  const SeedCloud seeds = SampleSeeds(*udf, options, Monitor::Null());
+  int octant[8] = {0};
+  for (const Vec3& p : seeds.position) ++octant[(p.x() > 0) + 2 * (p.y() > 0) + 4 * (p.z() > 0)];
+  for (int c : octant) EXPECT_GT(c, 60);
+}
+
+TEST(SampleSeeds, BadOptionsAreUsageErrors) {
+  SampleSeedsOptions options;
+  options.count = 0;
+  EXPECT_THROW(options.Check(), UsageError);
+  options.count = 10;
+  options.proj_tol_rel = 0;
+  EXPECT_THROW(options.Check(), UsageError);
+}
+
+class SampleSeedsExe : public ::testing::Test {
+ protected:
+  std::vector<std::string> Args(const std::string& shape, const std::string& out, const std::string& seed = "5") {
+    return {"--udf", "shape:" + shape, "--count", "300", "--seed", seed, "-o", out};
+  }
+  TempDir dir_;
+};
+
+TEST_F(SampleSeedsExe, WritesSeedsOnTheSurfaceForEveryShape) {
+  for (const char* name : kShapes) {
+    const std::string out = dir_ / (std::string(name) + ".ply");
+    const auto r = RunProgram("sample-seeds", Args(name, out));
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_TRUE(r.out.empty()) << "stdout is for machine-readable results only";
+    const SeedCloud seeds = ReadSeeds(out);
+    EXPECT_EQ(seeds.size(), 300u);
+    const auto udf = MakeShape(name);
+    // float32 storage adds up to ~1e-7 to the 1e-5 * diagonal tolerance.
+    const double tol = 1e-5 * udf->Domain().Diagonal() + 1e-6;
+    for (const Vec3& p : seeds.position) EXPECT_LT(udf->Distance(p), tol) << name;
+  }
+}
+
+TEST_F(SampleSeedsExe, SameSeedSameBytesWhateverTheThreadCount) {
+  auto a = Args("three-discs", dir_ / "a.ply");
+  auto b = Args("three-discs", dir_ / "b.ply");
+  b.insert(b.end(), {"--threads", "1"});
+  auto c = Args("three-discs", dir_ / "c.ply", "6");
+  ASSERT_EQ(RunProgram("sample-seeds", a).exit_code, 0);
+  ASSERT_EQ(RunProgram("sample-seeds", b).exit_code, 0);
+  ASSERT_EQ(RunProgram("sample-seeds", c).exit_code, 0);
+  EXPECT_EQ(test::ReadBytes(dir_ / "a.ply"), test::ReadBytes(dir_ / "b.ply"));
+  EXPECT_NE(test::ReadBytes(dir_ / "a.ply"), test::ReadBytes(dir_ / "c.ply"));
+}
+
+TEST_F(SampleSeedsExe, ProvenanceAndAscii) {
+  auto args = Args("cube", dir_ / "s.ply");
+  args.push_back("--ascii");
+  ASSERT_EQ(RunProgram("sample-seeds", args).exit_code, 0);
+  const std::string text = test::ReadBytes(dir_ / "s.ply");
+  EXPECT_NE(text.find("format ascii 1.0"), std::string::npos);
+  EXPECT_NE(text.find("comment voroudf seeds 1"), std::string::npos);
+  EXPECT_NE(text.find("comment stage sample-seeds"), std::string::npos);
+  EXPECT_NE(text.find("comment udf shape:cube"), std::string::npos);
+  EXPECT_NE(text.find("--count 300"), std::string::npos);
+  EXPECT_NE(text.find("--seed 5"), std::string::npos);
+}
+
+struct Failure {
+  std::vector<std::string> args;
+  int exit_code;
+  const char* message;
+};
+
+TEST_F(SampleSeedsExe, FailuresExitWithTheDocumentedCodeAndLeaveNoFile) {
+  const std::string out = dir_ / "out.ply";
+  const std::vector<Failure> failures = {
+      {{"--udf", "shape:sphere", "--count", "0", "-o", out}, kExitUsage, "--count must be at least 1"},
+      {{"--udf", "shape:sphere", "--count", "ten", "-o", out}, kExitUsage, "--count"},
+      {{"--udf", "shape:sphere", "--no-such-flag", "-o", out}, kExitUsage, "no-such-flag"},
+      {{"--udf", "shape:sphere", "--count", "10"}, kExitUsage, "--output is required"},
+      {{"--udf", "shape:pyramid", "--count", "10", "-o", out}, kExitBadInput, "unknown built-in shape"},
+      {{"--udf", "field.xyz", "--count", "10", "-o", out}, kExitBadInput, "expected shape:NAME"},
+      {{"--udf", "shape:sphere", "--count", "10", "-o", dir_ / "no/such/dir/s.ply"}, kExitFailure, "does not exist"},
+      {{"--udf", "shape:sphere", "--count", "10", "-o", dir_.path()}, kExitFailure, "is a directory"},
+  };
+  for (const auto& f : failures) {
+    const auto r = RunProgram("sample-seeds", f.args);
+    EXPECT_EQ(r.exit_code, f.exit_code) << r.err;
+    EXPECT_NE(r.err.find(f.message), std::string::npos) << r.err;
+    EXPECT_TRUE(dir_.List().empty()) << "a failed run left a file behind";
+    // One clear line: the error is the last line of stderr and starts with the program name.
+    const auto last = r.err.rfind("sample-seeds: error:");
+    ASSERT_NE(last, std::string::npos) << r.err;
+    EXPECT_EQ(r.err.find('\n', last), r.err.size() - 1);
+  }
+}
+
+TEST_F(SampleSeedsExe, HelpExplainsTheOptions) {
+  const auto r = RunProgram("sample-seeds", {"--help"});
+  EXPECT_EQ(r.exit_code, 0);
+  for (const char* flag : {"--udf", "--count", "--seed", "--threads", "--output", "--proj-tol-rel", "--ascii", "--quiet"})
+    EXPECT_NE(r.out.find(flag), std::string::npos) << flag;
+}
+
+}  // namespace
+}  // namespace voroudf
