@@ -1,0 +1,198 @@
+#include "common/mesh_topology.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+
+namespace voroudf {
+namespace {
+
+struct UnionFind {
+  std::vector<int> parent;
+  explicit UnionFind(size_t n) : parent(n) { std::iota(parent.begin(), parent.end(), 0); }
+  int Find(int x) {
+    while (parent[x] != x) x = parent[x] = parent[parent[x]];
+    return x;
+  }
+  void Unite(int a, int b) {
+    a = Find(a);
+    b = Find(b);
+    if (a != b) parent[std::max(a, b)] = std::min(a, b);
+  }
+};
+
+}  // namespace
+
+int EdgeFaces::Find(int a, int b) const {
+  const auto it = index.find(EdgeKey(MakeEdge(a, b)));
+  return it == index.end() ? -1 : it->second;
+}
+
+EdgeFaces BuildEdgeFaces(const std::vector<Tri>& faces) {
+  std::vector<std::pair<uint64_t, int>> incidences;
+  incidences.reserve(3 * faces.size());
+  for (size_t f = 0; f < faces.size(); ++f) {
+    const Tri& t = faces[f];
+    for (int k = 0; k < 3; ++k) {
+      const int a = t[k], b = t[(k + 1) % 3];
+      if (a == b) continue;
+      incidences.emplace_back(EdgeKey(MakeEdge(a, b)), static_cast<int>(f));
+    }
+  }
+  std::sort(incidences.begin(), incidences.end());
+  incidences.erase(std::unique(incidences.begin(), incidences.end()), incidences.end());
+  EdgeFaces ef;
+  for (const auto& [key, f] : incidences) {
+    if (ef.edges.empty() || EdgeKey(ef.edges.back()) != key) {
+      ef.edges.push_back({static_cast<int>(key >> 32), static_cast<int>(key & 0xffffffffu)});
+      ef.faces.emplace_back();
+    }
+    ef.faces.back().push_back(f);
+  }
+  ef.index.reserve(ef.edges.size());
+  for (size_t i = 0; i < ef.edges.size(); ++i) ef.index.emplace(EdgeKey(ef.edges[i]), static_cast<int>(i));
+  return ef;
+}
+
+TopologyStats ComputeTopology(const TriangleMesh& mesh) {
+  TopologyStats s;
+  const size_t nv = mesh.vertices.size();
+  s.num_faces = mesh.faces.size();
+  const EdgeFaces ef = BuildEdgeFaces(mesh.faces);
+  s.num_edges = ef.edges.size();
+
+  std::vector<char> used(nv, 0), on_nm_edge(nv, 0);
+  for (const Tri& t : mesh.faces)
+    for (int v : t) used[v] = 1;
+  s.num_vertices = static_cast<size_t>(std::count(used.begin(), used.end(), 1));
+  for (size_t e = 0; e < ef.edges.size(); ++e) {
+    const size_t valence = ef.faces[e].size();
+    if (valence == 1) ++s.boundary_edges;
+    if (valence >= 3) {
+      ++s.nonmanifold_edges;
+      on_nm_edge[ef.edges[e][0]] = on_nm_edge[ef.edges[e][1]] = 1;
+    }
+  }
+  s.euler = static_cast<long long>(s.num_vertices) - static_cast<long long>(s.num_edges) +
+            static_cast<long long>(s.num_faces);
+
+  // Fans: the faces around v, joined when they share an edge incident to v.
+  std::vector<std::vector<int>> vertex_faces(nv);
+  for (size_t f = 0; f < mesh.faces.size(); ++f)
+    for (int v : mesh.faces[f])
+      if (vertex_faces[v].empty() || vertex_faces[v].back() != static_cast<int>(f))
+        vertex_faces[v].push_back(static_cast<int>(f));
+  for (size_t v = 0; v < nv; ++v) {
+    if (!used[v]) continue;
+    if (on_nm_edge[v]) {
+      ++s.nonmanifold_vertices;
+      continue;
+    }
+    const auto& fs = vertex_faces[v];
+    UnionFind uf(fs.size());
+    // Faces around v sharing another vertex u share the edge (v, u).
+    std::unordered_map<int, int> first_with;
+    for (size_t i = 0; i < fs.size(); ++i) {
+      for (int u : mesh.faces[fs[i]]) {
+        if (u == static_cast<int>(v)) continue;
+        const auto [it, inserted] = first_with.emplace(u, static_cast<int>(i));
+        if (!inserted) uf.Unite(it->second, static_cast<int>(i));
+      }
+    }
+    int fans = 0;
+    for (size_t i = 0; i < fs.size(); ++i) fans += uf.Find(static_cast<int>(i)) == static_cast<int>(i);
+    if (fans > 1) ++s.nonmanifold_vertices;
+  }
+
+  UnionFind comp(nv);
+  for (const Tri& t : mesh.faces) {
+    comp.Unite(t[0], t[1]);
+    comp.Unite(t[1], t[2]);
+  }
+  for (size_t v = 0; v < nv; ++v) s.components += used[v] && comp.Find(static_cast<int>(v)) == static_cast<int>(v);
+  return s;
+}
+
+std::vector<int> EdgeConnectedComponents(const std::vector<Tri>& faces, int* num_components) {
+  const EdgeFaces ef = BuildEdgeFaces(faces);
+  UnionFind uf(faces.size());
+  for (const auto& fs : ef.faces)
+    for (size_t k = 1; k < fs.size(); ++k) uf.Unite(fs[0], fs[k]);
+  std::vector<int> id(faces.size(), -1), root_id(faces.size(), -1);
+  int n = 0;
+  for (size_t f = 0; f < faces.size(); ++f) {
+    const int r = uf.Find(static_cast<int>(f));
+    if (root_id[r] < 0) root_id[r] = n++;
+    id[f] = root_id[r];
+  }
+  if (num_components) *num_components = n;
+  return id;
+}
+
+TriangleMesh RemoveUnreferencedVertices(const TriangleMesh& mesh) {
+  std::vector<int> remap(mesh.vertices.size(), -1);
+  for (const Tri& t : mesh.faces)
+    for (int v : t) remap[v] = 0;
+  TriangleMesh out;
+  for (size_t v = 0; v < mesh.vertices.size(); ++v) {
+    if (remap[v] < 0) continue;
+    remap[v] = static_cast<int>(out.vertices.size());
+    out.vertices.push_back(mesh.vertices[v]);
+  }
+  out.faces.reserve(mesh.faces.size());
+  for (const Tri& t : mesh.faces) out.faces.push_back({remap[t[0]], remap[t[1]], remap[t[2]]});
+  return out;
+}
+
+TriangleMesh WeldVertices(const TriangleMesh& mesh, double tolerance) {
+  const size_t nv = mesh.vertices.size();
+  std::vector<int> target(nv);
+  std::iota(target.begin(), target.end(), 0);
+  if (tolerance > 0 && nv > 0) {
+    // Hash on a grid of cell `tolerance`; compare against the 27 neighbouring cells.
+    auto cell_of = [&](const Vec3& p) {
+      return std::array<long long, 3>{static_cast<long long>(std::floor(p.x() / tolerance)),
+                                      static_cast<long long>(std::floor(p.y() / tolerance)),
+                                      static_cast<long long>(std::floor(p.z() / tolerance))};
+    };
+    auto key_of = [](const std::array<long long, 3>& c) {
+      return static_cast<uint64_t>(c[0]) * 73856093ull ^ static_cast<uint64_t>(c[1]) * 19349663ull ^
+             static_cast<uint64_t>(c[2]) * 83492791ull;
+    };
+    std::unordered_map<uint64_t, std::vector<int>> grid;
+    UnionFind uf(nv);
+    const double tol2 = tolerance * tolerance;
+    for (size_t v = 0; v < nv; ++v) {
+      const auto c = cell_of(mesh.vertices[v]);
+      for (long long dx = -1; dx <= 1; ++dx)
+        for (long long dy = -1; dy <= 1; ++dy)
+          for (long long dz = -1; dz <= 1; ++dz) {
+            const auto it = grid.find(key_of({c[0] + dx, c[1] + dy, c[2] + dz}));
+            if (it == grid.end()) continue;
+            for (int u : it->second)
+              if ((mesh.vertices[u] - mesh.vertices[v]).squaredNorm() < tol2) uf.Unite(u, static_cast<int>(v));
+          }
+      grid[key_of(c)].push_back(static_cast<int>(v));
+    }
+    for (size_t v = 0; v < nv; ++v) target[v] = uf.Find(static_cast<int>(v));
+  }
+  TriangleMesh welded;
+  welded.vertices = mesh.vertices;
+  for (const Tri& t : mesh.faces) {
+    const Tri w{target[t[0]], target[t[1]], target[t[2]]};
+    if (w[0] == w[1] || w[1] == w[2] || w[0] == w[2]) continue;
+    welded.faces.push_back(w);
+  }
+  return RemoveUnreferencedVertices(welded);
+}
+
+double TriangleQuality(const Vec3& a, const Vec3& b, const Vec3& c) {
+  const double la = (b - c).norm(), lb = (c - a).norm(), lc = (a - b).norm();
+  const double area = 0.5 * (b - a).cross(c - a).norm();
+  const double half_perimeter = 0.5 * (la + lb + lc);
+  const double longest = std::max({la, lb, lc});
+  if (area <= 0.0 || half_perimeter <= 0.0 || longest <= 0.0) return 0.0;
+  return 6.0 / std::sqrt(3.0) * area / (half_perimeter * longest);
+}
+
+}  // namespace voroudf

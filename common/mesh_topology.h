@@ -1,0 +1,63 @@
+#pragma once
+// Combinatorics of indexed triangle sets that may be non-manifold: edge-to-face incidence, valences,
+// boundary and non-manifold edges and vertices, components, Euler characteristic, welding. Written by
+// hand because OpenMesh's halfedge structure cannot hold an edge with three or more faces (DESIGN.md).
+#include <array>
+#include <cstdint>
+#include <unordered_map>
+#include <vector>
+
+#include "common/types.h"
+
+namespace voroudf {
+
+using Edge = std::array<int, 2>;  ///< vertex indices, smaller first
+
+inline Edge MakeEdge(int a, int b) { return a < b ? Edge{a, b} : Edge{b, a}; }
+inline uint64_t EdgeKey(const Edge& e) {
+  return (static_cast<uint64_t>(static_cast<uint32_t>(e[0])) << 32) | static_cast<uint32_t>(e[1]);
+}
+
+/// Every undirected edge of the mesh with the faces that contain it, in a deterministic order
+/// (edges sorted by (v0, v1); faces in increasing index).
+struct EdgeFaces {
+  std::vector<Edge> edges;
+  std::vector<std::vector<int>> faces;  ///< per edge
+  std::unordered_map<uint64_t, int> index;  ///< EdgeKey -> position in `edges`
+
+  /// Position of edge (a, b), or -1.
+  int Find(int a, int b) const;
+};
+
+/// Builds the edge-face incidence. Degenerate faces (repeated vertex) contribute their distinct edges.
+EdgeFaces BuildEdgeFaces(const std::vector<Tri>& faces);
+
+struct TopologyStats {
+  size_t num_vertices = 0;          ///< referenced by at least one face
+  size_t num_edges = 0;
+  size_t num_faces = 0;
+  size_t boundary_edges = 0;        ///< valence 1
+  size_t nonmanifold_edges = 0;     ///< valence >= 3
+  size_t nonmanifold_vertices = 0;  ///< on a non-manifold edge, or whose faces form several fans
+  size_t components = 0;            ///< connected through shared vertices
+  long long euler = 0;              ///< V - E + F over referenced vertices
+};
+
+/// Counts over the mesh as given (no welding). \pre face indices are valid
+TopologyStats ComputeTopology(const TriangleMesh& mesh);
+
+/// Component id per face, faces connected when they share an edge; ids in order of first face.
+std::vector<int> EdgeConnectedComponents(const std::vector<Tri>& faces, int* num_components);
+
+/// Merges vertices closer than `tolerance` (grid hashing; the smallest index is kept), remaps faces,
+/// drops faces that became degenerate and vertices no face references.
+TriangleMesh WeldVertices(const TriangleMesh& mesh, double tolerance);
+
+/// Drops vertices no face references, renumbering the rest in order.
+TriangleMesh RemoveUnreferencedVertices(const TriangleMesh& mesh);
+
+/// Triangle quality of Frey & Borouchaki (paper, supplementary): (6/sqrt 3) * area / (half-perimeter *
+/// longest edge); 1 for an equilateral triangle, 0 for a degenerate one.
+double TriangleQuality(const Vec3& a, const Vec3& b, const Vec3& c);
+
+}  // namespace voroudf
