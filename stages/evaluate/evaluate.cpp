@@ -1,0 +1,426 @@
+#include "stages/evaluate/evaluate.h"
+
+#include <flann/flann.hpp>
+#include <omp.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <limits>
+#include <memory>
+
+#include "common/errors.h"
+#include "common/rng.h"
+
+namespace voroudf {
+namespace {
+
+// Queries go to FLANN in blocks so that progress can be reported between them.
+constexpr size_t kQueryBlock = 16384;
+
+// Surface-sample RNG streams of the two meshes: disjoint, so a mesh against itself shows the sampling floor
+// of the protocol instead of an artificial 0.
+constexpr uint64_t kRefStream = 0;
+constexpr uint64_t kMeshStream = 1ull << 40;
+
+using KdIndex = flann::Index<flann::L2_Simple<double>>;
+
+// FLANN keeps its own reordered copy of the points (KDTreeSingleIndex reorders by default), so `rows`
+// may go once the index is built.
+struct KdTree {
+  std::vector<double> rows;
+  std::unique_ptr<KdIndex> index;
+
+  explicit KdTree(const std::vector<Vec3>& points) : rows(3 * points.size()) {
+    for (size_t i = 0; i < points.size(); ++i)
+      for (int k = 0; k < 3; ++k) rows[3 * i + k] = points[i][k];
+    // Single kd-tree with exact search: randomised forests would make results depend on rand().
+    index = std::make_unique<KdIndex>(flann::Matrix<double>(rows.data(), points.size(), 3),
+                                      flann::KDTreeSingleIndexParams(10));
+    index->buildIndex();
+  }
+};
+
+flann::SearchParams ExactSearch() {
+  flann::SearchParams params(flann::FLANN_CHECKS_UNLIMITED, 0.0f, false);
+  params.cores = omp_get_max_threads();
+  return params;
+}
+
+std::vector<double> QueryRows(const std::vector<Vec3>& points, size_t begin, size_t end) {
+  std::vector<double> q(3 * (end - begin));
+  for (size_t i = begin; i < end; ++i)
+    for (int k = 0; k < 3; ++k) q[3 * (i - begin) + k] = points[i][k];
+  return q;
+}
+
+void CheckFaceIndices(const TriangleMesh& mesh, const std::string& what) {
+  const long long nv = static_cast<long long>(mesh.vertices.size());
+  for (size_t f = 0; f < mesh.faces.size(); ++f)
+    for (int v : mesh.faces[f])
+      if (v < 0 || v >= nv)
+        throw InputError(what, "face " + std::to_string(f) + " has vertex index " + std::to_string(v) +
+                                   " out of range [0, " + std::to_string(nv) + ")");
+}
+
+double TotalArea(const TriangleMesh& mesh) {
+  double area = 0;
+  for (const Tri& t : mesh.faces) {
+    const Vec3& a = mesh.vertices[t[0]];
+    area += 0.5 * (mesh.vertices[t[1]] - a).cross(mesh.vertices[t[2]] - a).norm();
+  }
+  return area;
+}
+
+std::string Number(double x) {
+  if (std::isinf(x)) return "\"inf\"";
+  if (std::isnan(x)) return "null";
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%.10g", x);
+  return buf;
+}
+
+std::string JsonString(const std::string& s) {
+  std::string out = "\"";
+  for (unsigned char c : s) {
+    if (c == '"' || c == '\\') {
+      out += '\\';
+      out += static_cast<char>(c);
+    } else if (c < 0x20) {
+      char buf[8];
+      std::snprintf(buf, sizeof buf, "\\u%04x", c);
+      out += buf;
+    } else {
+      out += static_cast<char>(c);
+    }
+  }
+  return out + "\"";
+}
+
+std::string Fmt(const char* format, double a, double b = 0, double c = 0) {
+  char buf[200];
+  std::snprintf(buf, sizeof buf, format, a, b, c);
+  return buf;
+}
+
+}  // namespace
+
+void EvaluateOptions::Check() const {
+  if (samples < 1 || samples > 100000000) throw UsageError("--samples must be in [1, 1e8]");
+  if (nm_samples < 1 || nm_samples > 100000000) throw UsageError("--nm-samples must be in [1, 1e8]");
+  if (!(edge_radius > 0 && edge_radius < 1)) throw UsageError("edge radius must be in (0, 1)");
+  if (!(edge_cos > 0 && edge_cos <= 1)) throw UsageError("edge cosine threshold must be in (0, 1]");
+  if (!(weld_tolerance >= 0 && weld_tolerance < 0.1)) throw UsageError("weld tolerance must be in [0, 0.1)");
+  if (empty_edge_points < 1) throw UsageError("the ECD stand-in needs at least one point");
+}
+
+Frame ReferenceFrame(const TriangleMesh& reference) {
+  if (reference.faces.empty()) throw InputError("reference", "has no face");
+  Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+  for (const Tri& t : reference.faces)
+    for (int v : t) {
+      lo = lo.cwiseMin(reference.vertices[v]);
+      hi = hi.cwiseMax(reference.vertices[v]);
+    }
+  const double extent = (hi - lo).maxCoeff();
+  if (!(extent > 0) || !std::isfinite(extent)) throw InputError("reference", "all its vertices coincide (bounding box of size 0)");
+  Frame frame;
+  frame.center = 0.5 * (lo + hi);
+  frame.scale = 1.0 / extent;
+  frame.ref_diagonal = (hi - lo).norm() * frame.scale;
+  return frame;
+}
+
+TriangleMesh ApplyFrame(const Frame& frame, const TriangleMesh& mesh) {
+  TriangleMesh out;
+  out.faces = mesh.faces;
+  out.vertices.resize(mesh.vertices.size());
+  for (size_t i = 0; i < mesh.vertices.size(); ++i) out.vertices[i] = frame.Apply(mesh.vertices[i]);
+  return out;
+}
+
+SurfaceSamples SampleSurface(const TriangleMesh& mesh, size_t count, uint64_t seed, uint64_t stream) {
+  const size_t nf = mesh.faces.size();
+  std::vector<double> cumulative(nf);
+  std::vector<Vec3> normal(nf, Vec3::Zero());
+  double total = 0;
+  size_t last_positive = 0;
+  for (size_t f = 0; f < nf; ++f) {
+    const Tri& t = mesh.faces[f];
+    const Vec3& a = mesh.vertices[t[0]];
+    const Vec3 cross = (mesh.vertices[t[1]] - a).cross(mesh.vertices[t[2]] - a);
+    const double twice_area = cross.norm();
+    if (twice_area > 0) {
+      normal[f] = cross / twice_area;
+      total += 0.5 * twice_area;
+      last_positive = f;
+    }
+    cumulative[f] = total;
+  }
+  SurfaceSamples s;
+  if (!(total > 0) || count == 0) return s;
+  s.points.resize(count);
+  s.normals.resize(count);
+#pragma omp parallel for schedule(static)
+  for (long long i = 0; i < static_cast<long long>(count); ++i) {
+    Rng rng(seed, stream + static_cast<uint64_t>(i));
+    const double r = rng.Uniform() * total;
+    // upper_bound skips zero-area faces: their cumulative value equals their predecessor's.
+    size_t f = static_cast<size_t>(std::upper_bound(cumulative.begin(), cumulative.end(), r) - cumulative.begin());
+    if (f >= nf || normal[f].isZero()) f = last_positive;  // r rounded up to the total
+    const Tri& t = mesh.faces[f];
+    const double su = std::sqrt(rng.Uniform()), v = rng.Uniform();
+    s.points[i] = (1 - su) * mesh.vertices[t[0]] + su * (1 - v) * mesh.vertices[t[1]] + su * v * mesh.vertices[t[2]];
+    s.normals[i] = normal[f];
+  }
+  return s;
+}
+
+std::vector<double> NearestDistances(const std::vector<Vec3>& from, const std::vector<Vec3>& to, Monitor& monitor) {
+  std::vector<double> distance(from.size());
+  if (from.empty()) return distance;
+  const KdTree tree(to);
+  const flann::SearchParams params = ExactSearch();
+  for (size_t begin = 0; begin < from.size(); begin += kQueryBlock) {
+    const size_t end = std::min(from.size(), begin + kQueryBlock);
+    std::vector<double> q = QueryRows(from, begin, end);
+    std::vector<int> index(end - begin);
+    std::vector<double> dist2(end - begin);
+    flann::Matrix<double> queries(q.data(), end - begin, 3);
+    flann::Matrix<int> indices(index.data(), end - begin, 1);
+    flann::Matrix<double> dists(dist2.data(), end - begin, 1);
+    tree.index->knnSearch(queries, indices, dists, 1, params);
+    for (size_t i = begin; i < end; ++i) distance[i] = (from[i] - to[index[i - begin]]).norm();
+    monitor.Advance(end - begin);
+  }
+  return distance;
+}
+
+ChamferDistances Chamfer(const std::vector<Vec3>& a, const std::vector<Vec3>& b, Monitor& monitor) {
+  if (a.empty() || b.empty()) throw NumericalError("Chamfer distance of an empty point set");
+  ChamferDistances c;
+  const std::vector<double> dab = NearestDistances(a, b, monitor);
+  const std::vector<double> dba = NearestDistances(b, a, monitor);
+  double sum = 0;
+  for (double d : dab) {
+    sum += d;
+    c.max_ab = std::max(c.max_ab, d);
+  }
+  c.mean_ab = sum / static_cast<double>(dab.size());
+  sum = 0;
+  for (double d : dba) {
+    sum += d;
+    c.max_ba = std::max(c.max_ba, d);
+  }
+  c.mean_ba = sum / static_cast<double>(dba.size());
+  return c;
+}
+
+std::vector<Vec3> EdgePoints(const SurfaceSamples& samples, double radius, double cos_threshold, Monitor& monitor) {
+  const size_t n = samples.points.size();
+  std::vector<Vec3> edge;
+  if (n == 0) return edge;
+  const KdTree tree(samples.points);
+  const flann::SearchParams params = ExactSearch();
+  std::vector<char> is_edge(n, 0);
+  for (size_t begin = 0; begin < n; begin += kQueryBlock) {
+    const size_t end = std::min(n, begin + kQueryBlock);
+    std::vector<double> q = QueryRows(samples.points, begin, end);
+    std::vector<std::vector<int>> indices;
+    std::vector<std::vector<double>> dists;
+    // L2_Simple works on squared distances, so is its radius.
+    tree.index->radiusSearch(flann::Matrix<double>(q.data(), end - begin, 3), indices, dists,
+                             static_cast<float>(radius * radius), params);
+#pragma omp parallel for schedule(static)
+    for (long long i = static_cast<long long>(begin); i < static_cast<long long>(end); ++i) {
+      const Vec3& ni = samples.normals[i];
+      for (int j : indices[i - begin])
+        if (std::abs(ni.dot(samples.normals[j])) < cos_threshold) {
+          is_edge[i] = 1;
+          break;
+        }
+    }
+    monitor.Advance(end - begin);
+  }
+  for (size_t i = 0; i < n; ++i)
+    if (is_edge[i]) edge.push_back(samples.points[i]);
+  return edge;
+}
+
+std::vector<Edge> NonManifoldEdges(const TriangleMesh& mesh) {
+  const EdgeFaces ef = BuildEdgeFaces(mesh.faces);
+  std::vector<Edge> out;
+  for (size_t e = 0; e < ef.edges.size(); ++e)
+    if (ef.faces[e].size() >= 3) out.push_back(ef.edges[e]);
+  return out;
+}
+
+std::vector<Vec3> SampleNonManifoldEdges(const TriangleMesh& mesh, size_t count, double* total_length) {
+  const std::vector<Edge> edges = NonManifoldEdges(mesh);
+  std::vector<double> cumulative(edges.size());
+  double total = 0;
+  for (size_t e = 0; e < edges.size(); ++e) {
+    total += (mesh.vertices[edges[e][1]] - mesh.vertices[edges[e][0]]).norm();
+    cumulative[e] = total;
+  }
+  if (total_length) *total_length = total;
+  std::vector<Vec3> points;
+  if (!(total > 0) || count == 0) return points;
+  points.resize(count);
+  for (size_t k = 0; k < count; ++k) {
+    const double s = (static_cast<double>(k) + 0.5) * total / static_cast<double>(count);
+    size_t e = static_cast<size_t>(std::upper_bound(cumulative.begin(), cumulative.end(), s) - cumulative.begin());
+    e = std::min(e, edges.size() - 1);
+    const Vec3& a = mesh.vertices[edges[e][0]];
+    const Vec3& b = mesh.vertices[edges[e][1]];
+    const double length = (b - a).norm();
+    const double start = e == 0 ? 0.0 : cumulative[e - 1];
+    const double t = length > 0 ? std::clamp((s - start) / length, 0.0, 1.0) : 0.0;
+    points[k] = a + t * (b - a);
+  }
+  return points;
+}
+
+double MeanTriangleQuality(const TriangleMesh& mesh) {
+  const size_t nf = mesh.faces.size();
+  if (nf == 0) return 0.0;
+  std::vector<double> q(nf);
+#pragma omp parallel for schedule(static)
+  for (long long f = 0; f < static_cast<long long>(nf); ++f) {
+    const Tri& t = mesh.faces[f];
+    q[f] = TriangleQuality(mesh.vertices[t[0]], mesh.vertices[t[1]], mesh.vertices[t[2]]);
+  }
+  double sum = 0;
+  for (double x : q) sum += x;
+  return sum / static_cast<double>(nf);
+}
+
+TopologyStats WeldedTopology(const TriangleMesh& mesh, double tolerance) {
+  return ComputeTopology(WeldVertices(mesh, tolerance));
+}
+
+Metrics Evaluate(const TriangleMesh& mesh_in, const TriangleMesh& reference_in, const EvaluateOptions& options,
+                 Monitor& monitor) {
+  options.Check();
+  CheckFaceIndices(reference_in, "reference");
+  CheckFaceIndices(mesh_in, "mesh");
+  Metrics m;
+  m.frame = ReferenceFrame(reference_in);
+  const TriangleMesh ref = ApplyFrame(m.frame, reference_in);
+  const TriangleMesh mesh = ApplyFrame(m.frame, mesh_in);
+  monitor.Info(Fmt("frame: reference bbox centre (%.6g, %.6g, %.6g)", m.frame.center.x(), m.frame.center.y(),
+                   m.frame.center.z()) +
+               Fmt(", scale %.6g, normalised diagonal %.6g", m.frame.scale, m.frame.ref_diagonal));
+  if (!(TotalArea(ref) > 0)) throw InputError("reference", "has no face of non-zero area");
+  if (!(TotalArea(mesh) > 0))
+    throw NumericalError("the mesh under test has no face of non-zero area (" + std::to_string(mesh.faces.size()) +
+                         " faces): nothing to compare with the reference");
+
+  m.mesh.vertices = mesh.vertices.size();
+  m.mesh.faces = mesh.faces.size();
+  m.ref.vertices = ref.vertices.size();
+  m.ref.faces = ref.faces.size();
+  m.mesh.tq = MeanTriangleQuality(mesh);
+  m.ref.tq = MeanTriangleQuality(ref);
+
+  // Welding first (also for the non-manifold edges of NM-CD): meshes written with one vertex per face
+  // corner (STL-like OBJ exports) would otherwise have no shared edge at all.
+  const TriangleMesh mesh_welded = WeldVertices(mesh, options.weld_tolerance);
+  const TriangleMesh ref_welded = WeldVertices(ref, options.weld_tolerance);
+  m.mesh.topology = ComputeTopology(mesh_welded);
+  m.ref.topology = ComputeTopology(ref_welded);
+  m.td = std::llabs(m.mesh.topology.euler - m.ref.topology.euler);
+
+  SurfaceSamples ref_samples, mesh_samples;
+  {
+    Task task(monitor, "sampling", 2);
+    ref_samples = SampleSurface(ref, options.samples, options.seed, kRefStream);
+    task.Advance();
+    mesh_samples = SampleSurface(mesh, options.samples, options.seed, kMeshStream);
+    task.Advance();
+  }
+  {
+    Task task(monitor, "CD/HD", 2 * options.samples);
+    const ChamferDistances c = Chamfer(ref_samples.points, mesh_samples.points, monitor);
+    m.cd_x1e3 = c.SumOfMeans() * 1e3;
+    m.hd_x1e3 = c.MaxOfMaxima() / m.frame.ref_diagonal * 1e3;
+    monitor.Info(Fmt("CD: mean ref->mesh %.6g + mean mesh->ref %.6g; HD: one-sided maxima %.6g", c.mean_ab, c.mean_ba,
+                     c.max_ab) + Fmt(" and %.6g", c.max_ba));
+  }
+
+  std::vector<Vec3> ref_edge, mesh_edge;
+  {
+    Task task(monitor, "edge points", 2 * options.samples);
+    ref_edge = EdgePoints(ref_samples, options.edge_radius, options.edge_cos, monitor);
+    mesh_edge = EdgePoints(mesh_samples, options.edge_radius, options.edge_cos, monitor);
+  }
+  m.ref.edge_points = ref_edge.size();
+  m.mesh.edge_points = mesh_edge.size();
+  if (ref_edge.empty()) {
+    m.ecd_x1e2 = 0.0;
+  } else {
+    if (mesh_edge.empty()) mesh_edge.assign(options.empty_edge_points, Vec3::Zero());
+    Task task(monitor, "ECD", ref_edge.size() + mesh_edge.size());
+    m.ecd_x1e2 = Chamfer(ref_edge, mesh_edge, monitor).SumOfMeans() * 1e2;
+  }
+
+  const std::vector<Vec3> ref_nm = SampleNonManifoldEdges(ref_welded, options.nm_samples, &m.ref.nonmanifold_length);
+  const std::vector<Vec3> mesh_nm = SampleNonManifoldEdges(mesh_welded, options.nm_samples, &m.mesh.nonmanifold_length);
+  if (ref_nm.empty() && mesh_nm.empty()) {
+    m.nmcd_x1e3 = 0.0;
+  } else if (ref_nm.empty() || mesh_nm.empty()) {
+    m.nmcd_x1e3 = std::numeric_limits<double>::infinity();
+  } else {
+    Task task(monitor, "NM-CD", ref_nm.size() + mesh_nm.size());
+    m.nmcd_x1e3 = Chamfer(ref_nm, mesh_nm, monitor).SumOfMeans() * 1e3;
+  }
+  monitor.Info(Fmt("CD %.6g (x1e3)  HD %.6g (x1e3)  ECD %.6g (x1e2)", m.cd_x1e3, m.hd_x1e3, m.ecd_x1e2) +
+               Fmt("  TQ %.4g  TD %.0f  NM-CD %.6g (x1e3)", m.mesh.tq, static_cast<double>(m.td), m.nmcd_x1e3));
+  return m;
+}
+
+std::string MetricsJson(const Metrics& m, const EvaluateOptions& options, const std::string& mesh_path,
+                        const std::string& reference_path, double seconds) {
+  std::string out = "{";
+  bool first = true;
+  auto raw = [&](const char* key, const std::string& value) {
+    out += (first ? "\"" : ", \"") + std::string(key) + "\": " + value;
+    first = false;
+  };
+  auto num = [&](const char* key, double value) { raw(key, Number(value)); };
+  auto count = [&](const char* key, long long value) { raw(key, std::to_string(value)); };
+  raw("mesh", JsonString(mesh_path));
+  raw("reference", JsonString(reference_path));
+  count("samples", static_cast<long long>(options.samples));
+  count("nm_samples", static_cast<long long>(options.nm_samples));
+  raw("seed", std::to_string(options.seed));
+  num("frame_scale", m.frame.scale);
+  count("vertices", static_cast<long long>(m.mesh.vertices));
+  count("faces", static_cast<long long>(m.mesh.faces));
+  num("cd_x1e3", m.cd_x1e3);
+  num("hd_x1e3", m.hd_x1e3);
+  num("ecd_x1e2", m.ecd_x1e2);
+  num("tq", m.mesh.tq);
+  count("td", m.td);
+  num("nmcd_x1e3", m.nmcd_x1e3);
+  count("euler_mesh", m.mesh.topology.euler);
+  count("euler_ref", m.ref.topology.euler);
+  auto report = [&](const std::string& prefix, const MeshReport& r) {
+    count((prefix + "nonmanifold_edges").c_str(), static_cast<long long>(r.topology.nonmanifold_edges));
+    count((prefix + "nonmanifold_vertices").c_str(), static_cast<long long>(r.topology.nonmanifold_vertices));
+    count((prefix + "boundary_edges").c_str(), static_cast<long long>(r.topology.boundary_edges));
+    count((prefix + "components").c_str(), static_cast<long long>(r.topology.components));
+    count((prefix + "edge_points").c_str(), static_cast<long long>(r.edge_points));
+    num((prefix + "nonmanifold_length").c_str(), r.nonmanifold_length);
+  };
+  report("", m.mesh);
+  count("ref_vertices", static_cast<long long>(m.ref.vertices));
+  count("ref_faces", static_cast<long long>(m.ref.faces));
+  num("ref_tq", m.ref.tq);
+  report("ref_", m.ref);
+  if (seconds >= 0) num("seconds", seconds);
+  return out + "}\n";
+}
+
+}  // namespace voroudf
