@@ -23,7 +23,7 @@ int main(int argc, char** argv) {
     options.plane_normal = voroudf::Vec3(normal[0], normal[1], normal[2]);
     options.Check();
   }, [&](voroudf::Monitor& monitor) {
-    const voroudf::TriangleMesh merged = voroudf::MakeOverlapNonManifold(voroudf::ReadMesh(input), options);
+    const voroudf::TriangleMesh merged = voroudf::MakeOverlapNonManifold(voroudf::ReadMesh(input), options, input);
     const voroudf::TopologyStats s = voroudf::ComputeTopology(merged);
     voroudf::WriteMeshPly(output, merged, cli.provenance());
     char json[512];

@@ -63,12 +63,13 @@ void OverlapOptions::Check() const {
   if (!(std::abs(plane_offset_rel) < 0.5)) throw UsageError("--offset-rel must be in (-0.5, 0.5)");
 }
 
-TriangleMesh MakeOverlapNonManifold(const TriangleMesh& input, const OverlapOptions& options) {
+TriangleMesh MakeOverlapNonManifold(const TriangleMesh& input, const OverlapOptions& options,
+                                    const std::string& name) {
   options.Check();
   const TriangleMesh mesh = WeldVertices(input, 0.0);
   Mesh base = ToCgal(mesh);
-  if (!CGAL::is_closed(base)) throw InputError("mesh", "is not closed: the overlap construction needs a solid");
-  if (PMP::does_self_intersect(base)) throw InputError("mesh", "intersects itself");
+  if (!CGAL::is_closed(base)) throw InputError(name, "is not closed: the overlap construction needs a solid");
+  if (PMP::does_self_intersect(base)) throw InputError(name, "intersects itself");
 
   Box box{Vec3::Constant(INFINITY), Vec3::Constant(-INFINITY)};
   for (const Vec3& v : mesh.vertices) {
@@ -84,7 +85,7 @@ TriangleMesh MakeOverlapNonManifold(const TriangleMesh& input, const OverlapOpti
   PMP::clip(negative, plane, CGAL::parameters::clip_volume(true));
   PMP::clip(positive, plane.opposite(), CGAL::parameters::clip_volume(true));
   if (negative.number_of_faces() == 0 || positive.number_of_faces() == 0)
-    throw InputError("mesh", "the cut plane does not cross the mesh");
+    throw InputError(name, "the cut plane does not cross the mesh");
   const Vec3 shift = -options.overlap_rel * diag * n;
   PMP::transform(Kernel::Aff_transformation_3(CGAL::TRANSLATION, Kernel::Vector_3(shift.x(), shift.y(), shift.z())),
                  positive);

@@ -22,6 +22,8 @@ struct OverlapOptions {
 /// The crossing curves become edges with four faces: the ground-truth non-manifold edges.
 /// \pre `mesh` is a closed, non-self-intersecting triangle mesh (InputError otherwise)
 /// \throws InputError if the mesh is open or self-intersecting or the plane misses it
-TriangleMesh MakeOverlapNonManifold(const TriangleMesh& mesh, const OverlapOptions& options);
+/// \param name  used in error messages (the file the mesh came from)
+TriangleMesh MakeOverlapNonManifold(const TriangleMesh& mesh, const OverlapOptions& options,
+                                    const std::string& name = "mesh");
 
 }  // namespace voroudf
