@@ -63,6 +63,9 @@ CLI::Option* StageCli::AddUdf(std::string* spec) {
   app_.add_option("--udf-box", udf_options_.grid_box, "domain box of a .npy grid: xmin,ymin,zmin,xmax,ymax,zmax");
   app_.add_option("--udf-timeout", udf_options_.exec_timeout_s, "seconds to wait for an exec: source's answer")
       ->check(CLI::PositiveNumber);
+  app_.add_flag("--udf-normalize", udf_options_.normalize,
+                "centre the source's box (a mesh's bbox) on the origin and scale its largest extent to 1; "
+                "outputs are in that frame");
   non_semantic_.insert("--udf-timeout");
   non_semantic_.insert("--udf");  // recorded on its own provenance line
   return opt;

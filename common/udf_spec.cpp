@@ -2,8 +2,13 @@
 
 #include <algorithm>
 #include <cctype>
+#include <sstream>
+#include <vector>
 
 #include "common/errors.h"
+#include "common/exec_udf.h"
+#include "common/grid_udf.h"
+#include "common/mesh_udf.h"
 #include "common/shapes.h"
 
 namespace voroudf {
@@ -20,7 +25,52 @@ std::string LowerExtension(const std::string& path) {
   return ext;
 }
 
+class NormalizedUdf : public Udf {
+ public:
+  NormalizedUdf(std::unique_ptr<Udf> inner, const Box& frame)
+      : inner_(std::move(inner)), center_(frame.Center()), scale_(1.0 / frame.Extent().maxCoeff()) {
+    const Box d = inner_->Domain();
+    domain_ = {(d.min - center_) * scale_, (d.max - center_) * scale_};
+  }
+  void EvaluateChunk(const Vec3* points, size_t count, double* distance, Vec3* gradient) const override {
+    std::vector<Vec3> original(count);
+    for (size_t i = 0; i < count; ++i) original[i] = center_ + points[i] / scale_;
+    inner_->EvaluateChunk(original.data(), count, distance, gradient);
+    for (size_t i = 0; i < count; ++i) distance[i] *= scale_;
+  }
+  void Evaluate(const Vec3* points, size_t count, double* distance, Vec3* gradient) const override {
+    std::vector<Vec3> original(count);
+    for (size_t i = 0; i < count; ++i) original[i] = center_ + points[i] / scale_;
+    inner_->Evaluate(original.data(), count, distance, gradient);
+    for (size_t i = 0; i < count; ++i) distance[i] *= scale_;
+  }
+  Box Domain() const override { return domain_; }
+  std::string Describe() const override {
+    std::ostringstream out;
+    out << inner_->Describe() << "; --udf-normalize: x' = (x - [" << center_.x() << "," << center_.y() << ","
+        << center_.z() << "]) * " << scale_ << ", domain " << FormatBox(domain_);
+    return out.str();
+  }
+
+ private:
+  std::unique_ptr<Udf> inner_;
+  Vec3 center_;
+  double scale_;
+  Box domain_;
+};
+
 }  // namespace
+
+std::string FormatBox(const Box& box) {
+  std::ostringstream out;
+  out << "[" << box.min.x() << "," << box.min.y() << "," << box.min.z() << "]-[" << box.max.x() << ","
+      << box.max.y() << "," << box.max.z() << "]";
+  return out.str();
+}
+
+std::unique_ptr<Udf> NormalizeUdf(std::unique_ptr<Udf> inner, const Box& frame) {
+  return std::make_unique<NormalizedUdf>(std::move(inner), frame);
+}
 
 UdfSourceKind ClassifyUdfSpec(const std::string& spec) {
   if (StartsWith(spec, "shape:")) return UdfSourceKind::kShape;
@@ -32,16 +82,31 @@ UdfSourceKind ClassifyUdfSpec(const std::string& spec) {
                    "': expected shape:NAME, a mesh (.obj .off .ply .stl), a grid (.npy) or exec:COMMAND");
 }
 
-std::unique_ptr<Udf> OpenUdf(const std::string& spec, const UdfSourceOptions& /*options*/) {
+std::unique_ptr<Udf> OpenUdf(const std::string& spec, const UdfSourceOptions& options) {
   switch (ClassifyUdfSpec(spec)) {
     case UdfSourceKind::kShape:
       return MakeShape(spec.substr(6));
-    case UdfSourceKind::kMesh:
-    case UdfSourceKind::kGrid:
-    case UdfSourceKind::kExec:
-      break;
+    case UdfSourceKind::kMesh: {
+      MeshUdfOptions mesh_options;
+      mesh_options.normalize = options.normalize;  // by the mesh's own bbox, not the inflated domain
+      return MeshUdf::Open(spec, mesh_options);
+    }
+    case UdfSourceKind::kGrid: {
+      std::unique_ptr<Udf> grid = GridUdf::Open(spec, options.grid_box);
+      if (!options.normalize) return grid;
+      const Box frame = grid->Domain();
+      return NormalizeUdf(std::move(grid), frame);
+    }
+    case UdfSourceKind::kExec: {
+      ExecUdfOptions exec_options;
+      exec_options.timeout_s = options.exec_timeout_s;
+      std::unique_ptr<Udf> exec = std::make_unique<ExecUdf>(spec.substr(5), exec_options);
+      if (!options.normalize) return exec;
+      const Box frame = exec->Domain();
+      return NormalizeUdf(std::move(exec), frame);
+    }
   }
-  throw InputError(spec, "this kind of UDF source is not implemented yet (only shape:NAME is)");
+  throw InputError(spec, "unknown kind of UDF source");
 }
 
 }  // namespace voroudf

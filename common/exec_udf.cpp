@@ -1,0 +1,297 @@
+#include "common/exec_udf.h"
+
+#include <errno.h>
+#include <fcntl.h>
+#include <omp.h>
+#include <poll.h>
+#include <pthread.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <sstream>
+#include <thread>
+#include <vector>
+
+#include "common/errors.h"
+#include "common/udf_spec.h"
+
+extern char** environ;
+
+namespace voroudf {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+std::string Printable(const char* data, size_t n) {
+  std::string s;
+  for (size_t i = 0; i < n; ++i) {
+    const unsigned char c = static_cast<unsigned char>(data[i]);
+    if (c >= 32 && c < 127) {
+      s += static_cast<char>(c);
+    } else {
+      char buf[8];
+      std::snprintf(buf, sizeof buf, "\\x%02x", c);
+      s += buf;
+    }
+  }
+  return s;
+}
+
+std::string DescribeStatus(int status) {
+  if (WIFEXITED(status)) return "exited with status " + std::to_string(WEXITSTATUS(status));
+  if (WIFSIGNALED(status)) return std::string("was killed by signal ") + strsignal(WTERMSIG(status));
+  return "stopped";
+}
+
+// write() with SIGPIPE blocked in this thread (a pending SIGPIPE it caused is consumed), so that a
+// server that closed its stdin gives EPIPE instead of killing us. Installing SIG_IGN process-wide would
+// change the behaviour of every other pipe the program writes to.
+ssize_t WriteNoSigpipe(int fd, const char* data, size_t n) {
+  sigset_t pipe_set, old_mask, pending;
+  sigemptyset(&pipe_set);
+  sigaddset(&pipe_set, SIGPIPE);
+  sigpending(&pending);
+  const bool was_pending = sigismember(&pending, SIGPIPE);
+  pthread_sigmask(SIG_BLOCK, &pipe_set, &old_mask);
+  const ssize_t r = ::write(fd, data, n);
+  const int saved = errno;
+  if (r < 0 && saved == EPIPE && !was_pending) {
+    const timespec zero{0, 0};
+    while (sigtimedwait(&pipe_set, nullptr, &zero) < 0 && errno == EINTR) {
+    }
+  }
+  pthread_sigmask(SIG_SETMASK, &old_mask, nullptr);
+  errno = saved;
+  return r;
+}
+
+void PutU32(std::string& s, uint32_t v) { s.append(reinterpret_cast<const char*>(&v), 4); }
+uint32_t GetU32(const char* p) {
+  uint32_t v;
+  std::memcpy(&v, p, 4);
+  return v;
+}
+
+}  // namespace
+
+ExecUdf::ExecUdf(const std::string& command, const ExecUdfOptions& options) : command_(command), options_(options) {
+  if (command_.empty()) throw InputError("exec:", "no command after 'exec:'");
+  int in_pipe[2], out_pipe[2];  // in_pipe: we write, child reads (its stdin); out_pipe: child writes
+  if (pipe2(in_pipe, O_CLOEXEC) != 0) throw InputError("exec:" + command_, std::string("pipe: ") + std::strerror(errno));
+  if (pipe2(out_pipe, O_CLOEXEC) != 0) {
+    close(in_pipe[0]), close(in_pipe[1]);
+    throw InputError("exec:" + command_, std::string("pipe: ") + std::strerror(errno));
+  }
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_adddup2(&actions, in_pipe[0], 0);
+  posix_spawn_file_actions_adddup2(&actions, out_pipe[1], 1);
+  posix_spawnattr_t attr;
+  posix_spawnattr_init(&attr);
+  sigset_t none, defaults;
+  sigemptyset(&none);
+  sigemptyset(&defaults);
+  sigaddset(&defaults, SIGPIPE);
+  posix_spawnattr_setsigmask(&attr, &none);
+  posix_spawnattr_setsigdefault(&attr, &defaults);
+  // Own process group, so that a shell pipeline or a server's children can be killed as one.
+  posix_spawnattr_setpgroup(&attr, 0);
+  posix_spawnattr_setflags(&attr, POSIX_SPAWN_SETPGROUP | POSIX_SPAWN_SETSIGMASK | POSIX_SPAWN_SETSIGDEF);
+  const char* argv[] = {"sh", "-c", command_.c_str(), nullptr};
+  const int rc = posix_spawn(&pid_, "/bin/sh", &actions, &attr, const_cast<char* const*>(argv), environ);
+  posix_spawn_file_actions_destroy(&actions);
+  posix_spawnattr_destroy(&attr);
+  close(in_pipe[0]);
+  close(out_pipe[1]);
+  to_child_ = in_pipe[1];
+  from_child_ = out_pipe[0];
+  if (rc != 0) {
+    pid_ = -1;
+    close(to_child_), close(from_child_);
+    throw InputError("exec:" + command_, std::string("cannot run /bin/sh: ") + std::strerror(rc));
+  }
+  fcntl(to_child_, F_SETFL, fcntl(to_child_, F_GETFL) | O_NONBLOCK);
+  fcntl(from_child_, F_SETFL, fcntl(from_child_, F_GETFL) | O_NONBLOCK);
+
+  // Handshake: "VUDF", uint32 version, 6 float32 box, uint32 name length, name.
+  char head[36];
+  Exchange("", head, sizeof head, "the handshake");
+  if (std::memcmp(head, "VUDF", 4) != 0)
+    Fail("not a voroudf UDF server: its output starts with '" + Printable(head, 4) +
+         "', expected the magic 'VUDF' (docs/exec-protocol.md)");
+  const uint32_t version = GetU32(head + 4);
+  if (version != kVersion)
+    Fail("the server speaks protocol version " + std::to_string(version) + ", this program knows version " +
+         std::to_string(kVersion));
+  float box[6];
+  std::memcpy(box, head + 8, sizeof box);
+  for (float b : box)
+    if (!std::isfinite(b)) Fail("the handshake's domain box has a non-finite number");
+  domain_ = Box{Vec3(box[0], box[1], box[2]), Vec3(box[3], box[4], box[5])};
+  if (!(domain_.min.array() < domain_.max.array()).all()) Fail("the handshake's domain box is empty (min >= max)");
+  const uint32_t name_len = GetU32(head + 32);
+  if (name_len > 4096) Fail("the handshake's server name is " + std::to_string(name_len) + " bytes long (at most 4096)");
+  server_name_.resize(name_len);
+  if (name_len > 0) Exchange("", server_name_.data(), name_len, "the handshake's server name");
+  server_name_ = Printable(server_name_.data(), server_name_.size());
+}
+
+ExecUdf::~ExecUdf() {
+  if (to_child_ >= 0) close(to_child_);  // EOF on the server's stdin: the protocol's "goodbye"
+  to_child_ = -1;
+  if (pid_ > 0) Reap(2.0);
+  if (from_child_ >= 0) close(from_child_);
+}
+
+bool ExecUdf::Reap(double wait_s) const {
+  // Waits for the process to exit on its own, else SIGTERMs then SIGKILLs its process group; always
+  // reaps it, so no zombie stays behind. Returns whether it exited on its own.
+  if (pid_ <= 0) return true;
+  int status = 0;
+  const auto give_up = Clock::now() + std::chrono::duration<double>(wait_s);
+  for (;;) {
+    const pid_t r = waitpid(pid_, &status, WNOHANG);
+    if (r == pid_ || r < 0) {
+      if (r == pid_) exit_status_ = status;
+      pid_ = -1;
+      return true;
+    }
+    if (Clock::now() >= give_up) break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  kill(-pid_, SIGTERM);
+  const auto kill_deadline = Clock::now() + std::chrono::milliseconds(500);
+  while (waitpid(pid_, &status, WNOHANG) == 0) {
+    if (Clock::now() >= kill_deadline) {
+      kill(-pid_, SIGKILL);
+      waitpid(pid_, &status, 0);
+      break;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  pid_ = -1;
+  return false;
+}
+
+void ExecUdf::Fail(const std::string& problem) const {
+  std::string message = problem;
+  // A dead server explains itself by its exit status; give it a moment to finish dying, then kill it.
+  if (Reap(0.2) && exit_status_ != -1) message += " (the process " + DescribeStatus(exit_status_) + ")";
+  if (to_child_ >= 0) close(to_child_), to_child_ = -1;
+  if (from_child_ >= 0) close(from_child_), from_child_ = -1;
+  failure_ = "exec:" + command_ + ": " + message;
+  throw InputError(failure_);
+}
+
+void ExecUdf::Exchange(const std::string& out, char* in, size_t in_len, const std::string& what) const {
+  const auto deadline = Clock::now() + std::chrono::duration<double>(options_.timeout_s);
+  size_t written = 0, got = 0;
+  while (written < out.size() || got < in_len) {
+    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - Clock::now()).count();
+    if (left <= 0) {
+      std::ostringstream msg;
+      msg << "no complete answer within --udf-timeout " << options_.timeout_s << " s while waiting for " << what
+          << " (received " << got << " of " << in_len << " bytes)";
+      Fail(msg.str());
+    }
+    pollfd fds[2];
+    int nfds = 0;
+    int out_slot = -1, in_slot = -1;
+    if (written < out.size()) out_slot = nfds, fds[nfds++] = {to_child_, POLLOUT, 0};
+    if (got < in_len) in_slot = nfds, fds[nfds++] = {from_child_, POLLIN, 0};
+    const int r = poll(fds, nfds, static_cast<int>(std::min<long long>(left, 1000)));
+    if (r < 0) {
+      if (errno == EINTR) continue;
+      Fail(std::string("poll: ") + std::strerror(errno));
+    }
+    if (r == 0) continue;
+    if (in_slot >= 0 && (fds[in_slot].revents & (POLLIN | POLLHUP | POLLERR))) {
+      const ssize_t n = ::read(from_child_, in + got, in_len - got);
+      if (n > 0) {
+        got += static_cast<size_t>(n);
+      } else if (n == 0) {
+        Fail("the process ended (closed its stdout) while we waited for " + what + " (received " + std::to_string(got) +
+             " of " + std::to_string(in_len) + " bytes)");
+      } else if (errno != EAGAIN && errno != EINTR) {
+        Fail(std::string("read: ") + std::strerror(errno));
+      }
+    }
+    if (out_slot >= 0 && (fds[out_slot].revents & (POLLOUT | POLLHUP | POLLERR))) {
+      const ssize_t n = WriteNoSigpipe(to_child_, out.data() + written, out.size() - written);
+      if (n > 0) {
+        written += static_cast<size_t>(n);
+      } else if (n < 0 && errno == EPIPE) {
+        Fail("the process ended (closed its stdin) before reading the request for " + what);
+      } else if (n < 0 && errno != EAGAIN && errno != EINTR) {
+        Fail(std::string("write: ") + std::strerror(errno));
+      }
+    }
+  }
+}
+
+void ExecUdf::Query(const Vec3* points, size_t count, double* distance, Vec3* gradient) const {
+  if (!failure_.empty()) throw InputError(failure_);
+  std::string request;
+  request.reserve(4 + 12 * count);
+  PutU32(request, static_cast<uint32_t>(count));
+  for (size_t i = 0; i < count; ++i) {
+    const float xyz[3] = {static_cast<float>(points[i].x()), static_cast<float>(points[i].y()),
+                          static_cast<float>(points[i].z())};
+    request.append(reinterpret_cast<const char*>(xyz), sizeof xyz);
+  }
+  std::vector<char> answer(4 + 16 * count);
+  const std::string what = "the answer to a request of " + std::to_string(count) + " points";
+  // The count first: a server answering another count is caught before we wait for bytes that never come.
+  Exchange(request, answer.data(), 4, what);
+  const uint32_t echoed = GetU32(answer.data());
+  if (echoed != count)
+    Fail("answered " + std::to_string(echoed) + " values to a request of " + std::to_string(count) +
+         " points (wrong count or garbage)");
+  Exchange("", answer.data() + 4, 16 * count, what);
+  const float* d = reinterpret_cast<const float*>(answer.data() + 4);
+  const float* g = d + count;
+  for (size_t i = 0; i < count; ++i) {
+    const Vec3 gi(g[3 * i], g[3 * i + 1], g[3 * i + 2]);
+    if (!std::isfinite(d[i]) || !gi.allFinite())
+      Fail("answered a non-finite distance or gradient for point " + std::to_string(answered_ + i) + " (garbage?)");
+    // Learned fields dip slightly below zero; the UDF is max(d, 0).
+    distance[i] = std::max(0.0, static_cast<double>(d[i]));
+    const double len = gi.norm();
+    gradient[i] = len > 0.0 ? Vec3(gi / len) : Vec3::Zero();
+  }
+  answered_ += count;
+}
+
+void ExecUdf::EvaluateChunk(const Vec3* points, size_t count, double* distance, Vec3* gradient) const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  try {
+    for (size_t begin = 0; begin < count; begin += options_.max_batch) {
+      const size_t n = std::min(options_.max_batch, count - begin);
+      Query(points + begin, n, distance + begin, gradient + begin);
+    }
+  } catch (const Error& e) {
+    if (!omp_in_parallel()) throw;
+    // An exception cannot leave an OpenMP region (std::terminate); end as the top-level handler would.
+    std::fprintf(stderr, "%s: error: %s\n", program_invocation_short_name, e.what());
+    std::fflush(stderr);
+    _exit(kExitBadInput);
+  }
+}
+
+void ExecUdf::Evaluate(const Vec3* points, size_t count, double* distance, Vec3* gradient) const {
+  // One thread is enough: the server does the work; large requests amortise the round trips.
+  EvaluateChunk(points, count, distance, gradient);
+}
+
+std::string ExecUdf::Describe() const {
+  return "exec:" + command_ + " (server '" + server_name_ + "', protocol " + std::to_string(kVersion) + "; domain " +
+         FormatBox(domain_) + " from the handshake)";
+}
+
+}  // namespace voroudf

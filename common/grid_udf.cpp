@@ -1,0 +1,353 @@
+#include "common/grid_udf.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+#include <sys/stat.h>
+
+#include "common/atomic_file.h"
+#include "common/errors.h"
+#include "common/udf_spec.h"
+
+namespace voroudf {
+namespace {
+
+std::string ReadAll(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(path, std::string("cannot open: ") + std::strerror(errno));
+  std::ostringstream s;
+  s << in.rdbuf();
+  if (in.bad()) throw InputError(path, "read error");
+  return s.str();
+}
+
+bool FileExists(const std::string& path) {
+  struct stat st;
+  return ::stat(path.c_str(), &st) == 0 && S_ISREG(st.st_mode);
+}
+
+// The value of key `key` in NumPy's header, a Python dict literal such as
+// {'descr': '<f4', 'fortran_order': False, 'shape': (64, 64, 64), }: the text up to the next top-level ','.
+std::string HeaderValue(const std::string& header, const std::string& key, const std::string& path) {
+  size_t pos = header.find("'" + key + "'");
+  if (pos == std::string::npos) pos = header.find("\"" + key + "\"");
+  if (pos == std::string::npos) throw InputError(path, "NumPy header has no '" + key + "' (not a .npy file?)");
+  pos = header.find(':', pos);
+  if (pos == std::string::npos) throw InputError(path, "malformed NumPy header");
+  ++pos;
+  int depth = 0;
+  size_t end = pos;
+  for (; end < header.size(); ++end) {
+    const char c = header[end];
+    if (c == '(' || c == '[') ++depth;
+    if (c == ')' || c == ']') --depth;
+    if ((c == ',' && depth == 0) || c == '}') break;
+  }
+  std::string v = header.substr(pos, end - pos);
+  const auto first = v.find_first_not_of(" \t");
+  const auto last = v.find_last_not_of(" \t");
+  return first == std::string::npos ? "" : v.substr(first, last - first + 1);
+}
+
+// Catmull-Rom (Keys a = -1/2) weights and their derivatives for the samples at i0-1 .. i0+2, folded so that
+// the ghost nodes -1 and n (linear extrapolation: f(-1) = 2 f(0) - f(1)) become weights on real nodes.
+struct Stencil {
+  size_t idx[4];
+  double w[4], dw[4];
+};
+
+Stencil AxisStencil(double u, size_t n) {
+  // u is the position in grid units, already clamped to [0, n - 1]; n >= 2.
+  size_t i0 = static_cast<size_t>(std::floor(u));
+  if (i0 > n - 2) i0 = n - 2;
+  const double t = u - static_cast<double>(i0);
+  const double t2 = t * t, t3 = t2 * t;
+  Stencil s;
+  s.w[0] = 0.5 * (-t3 + 2 * t2 - t);
+  s.w[1] = 0.5 * (3 * t3 - 5 * t2 + 2);
+  s.w[2] = 0.5 * (-3 * t3 + 4 * t2 + t);
+  s.w[3] = 0.5 * (t3 - t2);
+  s.dw[0] = 0.5 * (-3 * t2 + 4 * t - 1);
+  s.dw[1] = 0.5 * (9 * t2 - 10 * t);
+  s.dw[2] = 0.5 * (-9 * t2 + 8 * t + 1);
+  s.dw[3] = 0.5 * (3 * t2 - 2 * t);
+  s.idx[1] = i0;
+  s.idx[2] = i0 + 1;
+  if (i0 == 0) {  // ghost -1 = 2 f(0) - f(1)
+    s.w[1] += 2 * s.w[0], s.w[2] -= s.w[0], s.dw[1] += 2 * s.dw[0], s.dw[2] -= s.dw[0];
+    s.w[0] = s.dw[0] = 0.0;
+    s.idx[0] = i0;
+  } else {
+    s.idx[0] = i0 - 1;
+  }
+  if (i0 + 2 >= n) {  // ghost n = 2 f(n-1) - f(n-2)
+    s.w[2] += 2 * s.w[3], s.w[1] -= s.w[3], s.dw[2] += 2 * s.dw[3], s.dw[1] -= s.dw[3];
+    s.w[3] = s.dw[3] = 0.0;
+    s.idx[3] = i0 + 1;
+  } else {
+    s.idx[3] = i0 + 2;
+  }
+  return s;
+}
+
+}  // namespace
+
+NpyArray ReadNpyFloat32(const std::string& path) {
+  const std::string bytes = ReadAll(path);
+  if (bytes.size() < 10 || std::memcmp(bytes.data(), "\x93NUMPY", 6) != 0)
+    throw InputError(path, "not a NumPy .npy file (no \\x93NUMPY magic)");
+  const int major = static_cast<unsigned char>(bytes[6]);
+  size_t header_len, offset;
+  if (major == 1) {
+    header_len = static_cast<unsigned char>(bytes[8]) | (static_cast<size_t>(static_cast<unsigned char>(bytes[9])) << 8);
+    offset = 10;
+  } else if (major == 2 || major == 3) {
+    if (bytes.size() < 12) throw InputError(path, "truncated NumPy header");
+    uint32_t len;
+    std::memcpy(&len, bytes.data() + 8, 4);
+    header_len = len;
+    offset = 12;
+  } else {
+    throw InputError(path, "unsupported .npy format version " + std::to_string(major) + " (expected 1, 2 or 3)");
+  }
+  if (bytes.size() < offset + header_len) throw InputError(path, "truncated NumPy header");
+  const std::string header = bytes.substr(offset, header_len);
+  offset += header_len;
+
+  std::string descr = HeaderValue(header, "descr", path);
+  descr.erase(std::remove_if(descr.begin(), descr.end(), [](char c) { return c == '\'' || c == '"'; }), descr.end());
+  if (descr != "<f4" && descr != "|f4")
+    throw InputError(path, "dtype '" + descr + "' is not supported: expected little-endian float32 ('<f4'); "
+                           "save with arr.astype('<f4')");
+  const std::string fortran = HeaderValue(header, "fortran_order", path);
+  if (fortran != "False")
+    throw InputError(path, "the array is in Fortran order: expected C order (save np.ascontiguousarray(arr))");
+  const std::string shape_text = HeaderValue(header, "shape", path);
+  NpyArray array;
+  {
+    std::string digits;
+    for (char c : shape_text) {
+      if (std::isdigit(static_cast<unsigned char>(c))) {
+        digits += c;
+      } else {
+        if (!digits.empty()) array.shape.push_back(std::stoull(digits));
+        digits.clear();
+        if (c != '(' && c != ')' && c != ',' && c != ' ' && c != 'L')
+          throw InputError(path, "malformed shape " + shape_text + " in the NumPy header");
+      }
+    }
+  }
+  size_t count = 1;
+  for (size_t s : array.shape) {
+    if (s != 0 && count > (size_t(1) << 40) / s) throw InputError(path, "array too large: shape " + shape_text);
+    count *= s;
+  }
+  const size_t need = count * sizeof(float);
+  if (bytes.size() - offset < need)
+    throw InputError(path, "truncated: shape " + shape_text + " needs " + std::to_string(need) + " data bytes, the file has " +
+                               std::to_string(bytes.size() - offset));
+  if (bytes.size() - offset > need)
+    throw InputError(path, "has " + std::to_string(bytes.size() - offset - need) + " bytes after the array of shape " + shape_text);
+  array.data.resize(count);
+  std::memcpy(array.data.data(), bytes.data() + offset, need);  // the machine is little-endian (x86-64, arm64)
+  return array;
+}
+
+void WriteNpyFloat32(const std::string& path, const std::vector<size_t>& shape, const std::vector<float>& data) {
+  std::string dims;
+  for (size_t s : shape) dims += std::to_string(s) + ", ";
+  if (shape.size() > 1) dims.erase(dims.size() - 2);
+  else if (shape.size() == 1) dims.erase(dims.size() - 1);
+  std::string header = "{'descr': '<f4', 'fortran_order': False, 'shape': (" + dims + "), }";
+  // Magic (6) + version (2) + length (2) + header + '\n' is padded to a multiple of 64 bytes.
+  const size_t total = 10 + header.size() + 1;
+  header.append((64 - total % 64) % 64, ' ');
+  header += '\n';
+  std::string bytes("\x93NUMPY\x01\x00", 8);
+  bytes += static_cast<char>(header.size() & 0xff);
+  bytes += static_cast<char>(header.size() >> 8);
+  bytes += header;
+  bytes.append(reinterpret_cast<const char*>(data.data()), data.size() * sizeof(float));
+  WriteFileAtomically(path, bytes);
+}
+
+Box ParseBoxOption(const std::string& text) {
+  std::vector<double> v;
+  std::stringstream in(text);
+  std::string item;
+  while (std::getline(in, item, ',')) {
+    char* end = nullptr;
+    const double x = std::strtod(item.c_str(), &end);
+    if (item.empty() || end == item.c_str() || *end != '\0' || !std::isfinite(x))
+      throw UsageError("--udf-box '" + text + "': expected six numbers xmin,ymin,zmin,xmax,ymax,zmax");
+    v.push_back(x);
+  }
+  if (v.size() != 6) throw UsageError("--udf-box '" + text + "': expected six numbers xmin,ymin,zmin,xmax,ymax,zmax");
+  Box box{Vec3(v[0], v[1], v[2]), Vec3(v[3], v[4], v[5])};
+  if (!(box.min.array() < box.max.array()).all())
+    throw UsageError("--udf-box '" + text + "': each min must be below its max");
+  return box;
+}
+
+Box ReadBoxJson(const std::string& path) {
+  const std::string text = ReadAll(path);
+  const size_t key = text.find("\"box\"");
+  if (key == std::string::npos) throw InputError(path, "no \"box\" key (expected {\"box\": [[x0,y0,z0],[x1,y1,z1]]})");
+  size_t pos = key + 5;
+  auto expect = [&](char c) {
+    while (pos < text.size() && std::isspace(static_cast<unsigned char>(text[pos]))) ++pos;
+    if (pos >= text.size() || text[pos] != c)
+      throw InputError(path, std::string("malformed \"box\": expected '") + c + "' (format {\"box\": [[x0,y0,z0],[x1,y1,z1]]})");
+    ++pos;
+  };
+  auto number = [&]() {
+    while (pos < text.size() && std::isspace(static_cast<unsigned char>(text[pos]))) ++pos;
+    const char* start = text.c_str() + pos;
+    char* end = nullptr;
+    const double x = std::strtod(start, &end);
+    if (end == start || !std::isfinite(x)) throw InputError(path, "malformed \"box\": expected a finite number");
+    pos += static_cast<size_t>(end - start);
+    return x;
+  };
+  expect(':');
+  expect('[');
+  Vec3 corner[2];
+  for (int c = 0; c < 2; ++c) {
+    if (c == 1) expect(',');
+    expect('[');
+    for (int k = 0; k < 3; ++k) {
+      if (k > 0) expect(',');
+      corner[c][k] = number();
+    }
+    expect(']');
+  }
+  expect(']');
+  if (!(corner[0].array() < corner[1].array()).all())
+    throw InputError(path, "\"box\": each min must be below its max");
+  return Box{corner[0], corner[1]};
+}
+
+GridUdf::GridUdf(const std::vector<float>& values, std::array<size_t, 3> dims, const Box& box,
+                 std::vector<float> gradient, std::string name)
+    : gradient_(std::move(gradient)), dims_(dims), box_(box), name_(std::move(name)) {
+  for (size_t n : dims_)
+    if (n < 2) throw InputError(name_, "every grid axis needs at least 2 samples (shape " + std::to_string(dims_[0]) +
+                                           "x" + std::to_string(dims_[1]) + "x" + std::to_string(dims_[2]) + ")");
+  const size_t count = dims_[0] * dims_[1] * dims_[2];
+  if (values.size() != count) throw InputError(name_, "grid has " + std::to_string(values.size()) + " values, expected " + std::to_string(count));
+  if (!gradient_.empty() && gradient_.size() != 3 * count)
+    throw InputError(name_, "gradient array has " + std::to_string(gradient_.size()) + " values, expected 3 * " + std::to_string(count));
+  if (!(box_.min.array() < box_.max.array()).all()) throw InputError(name_, "the grid's box is empty");
+  q_.resize(count);
+  for (size_t i = 0; i < count; ++i) {
+    if (!std::isfinite(values[i])) throw InputError(name_, "sample " + std::to_string(i) + " is not finite");
+    const double d = std::max(0.0, static_cast<double>(values[i]));
+    q_[i] = static_cast<float>(d * d);
+  }
+  for (float g : gradient_)
+    if (!std::isfinite(g)) throw InputError(name_, "the gradient array has a non-finite value");
+  for (int k = 0; k < 3; ++k) h_[k] = box_.Extent()[k] / static_cast<double>(dims_[k] - 1);
+}
+
+std::unique_ptr<GridUdf> GridUdf::Open(const std::string& path, const std::string& box_option) {
+  Box box;
+  std::string box_source;
+  const std::string json = path.substr(0, path.size() - 4) + ".json";
+  if (!box_option.empty()) {
+    box = ParseBoxOption(box_option);
+    box_source = "--udf-box";
+  } else if (FileExists(json)) {
+    box = ReadBoxJson(json);
+    box_source = json;
+  } else {
+    throw InputError(path, "no domain box: give --udf-box xmin,ymin,zmin,xmax,ymax,zmax or write " + json +
+                               " as {\"box\": [[x0,y0,z0],[x1,y1,z1]]}");
+  }
+  NpyArray values = ReadNpyFloat32(path);
+  if (values.shape.size() != 3)
+    throw InputError(path, "expected a 3-D array [nx,ny,nz] of distances, got rank " + std::to_string(values.shape.size()));
+  const std::array<size_t, 3> dims{values.shape[0], values.shape[1], values.shape[2]};
+  std::vector<float> gradient;
+  const std::string grad_path = path.substr(0, path.size() - 4) + "_grad.npy";
+  if (FileExists(grad_path)) {
+    NpyArray g = ReadNpyFloat32(grad_path);
+    if (g.shape != std::vector<size_t>{dims[0], dims[1], dims[2], 3})
+      throw InputError(grad_path, "expected shape [" + std::to_string(dims[0]) + "," + std::to_string(dims[1]) + "," +
+                                      std::to_string(dims[2]) + ",3] to match the distances");
+    gradient = std::move(g.data);
+  }
+  auto udf = std::make_unique<GridUdf>(values.data, dims, box, std::move(gradient), path);
+  udf->box_source_ = box_source;
+  if (!udf->gradient_.empty()) udf->box_source_ += "; gradients from " + grad_path;
+  return udf;
+}
+
+void GridUdf::EvaluateChunk(const Vec3* points, size_t count, double* distance, Vec3* gradient) const {
+  const bool given = !gradient_.empty();
+  const double tiny = 1e-14 * box_.Diagonal();
+  for (size_t n = 0; n < count; ++n) {
+    const Vec3& x = points[n];
+    if (!x.allFinite()) {
+      distance[n] = std::numeric_limits<double>::quiet_NaN();
+      gradient[n] = Vec3::Zero();
+      continue;
+    }
+    const Vec3 p = x.cwiseMax(box_.min).cwiseMin(box_.max);
+    Stencil s[3];
+    for (int k = 0; k < 3; ++k) s[k] = AxisStencil((p[k] - box_.min[k]) / h_[k], dims_[k]);
+    double q = 0.0;
+    Vec3 dq = Vec3::Zero();
+    Vec3 g_given = Vec3::Zero();
+    for (int a = 0; a < 4; ++a) {
+      for (int b = 0; b < 4; ++b) {
+        const size_t row = (s[0].idx[a] * dims_[1] + s[1].idx[b]) * dims_[2];
+        double f = 0.0, fz = 0.0;
+        Vec3 gz = Vec3::Zero();
+        for (int c = 0; c < 4; ++c) {
+          const double v = q_[row + s[2].idx[c]];
+          f += s[2].w[c] * v;
+          fz += s[2].dw[c] * v;
+          if (given) {
+            const float* g = &gradient_[3 * (row + s[2].idx[c])];
+            gz += s[2].w[c] * Vec3(g[0], g[1], g[2]);
+          }
+        }
+        const double wab = s[0].w[a] * s[1].w[b];
+        q += wab * f;
+        dq.x() += s[0].dw[a] * s[1].w[b] * f;
+        dq.y() += s[0].w[a] * s[1].dw[b] * f;
+        dq.z() += wab * fz;
+        if (given) g_given += wab * gz;
+      }
+    }
+    dq = dq.cwiseQuotient(h_);
+    const double d_in = std::sqrt(std::max(q, 0.0));
+    // In-box part of the gradient of d: grad q / 2d, or the given gradient.
+    Vec3 g_in = given ? g_given : (d_in > 0.0 ? Vec3(dq / (2.0 * d_in)) : dq);
+    const Vec3 out = x - p;
+    const double out_len = out.norm();
+    Vec3 g = g_in;
+    if (out_len > 0.0) {
+      // Outside the box: d(p) + |x - p|; along the clamped axes the second term is the whole derivative.
+      for (int k = 0; k < 3; ++k)
+        if (out[k] != 0.0) g[k] = out[k] / out_len;
+    }
+    distance[n] = d_in + out_len;
+    const double len = g.norm();
+    gradient[n] = (len > tiny && std::isfinite(len)) ? Vec3(g / len) : Vec3::Zero();
+  }
+}
+
+std::string GridUdf::Describe() const {
+  std::ostringstream out;
+  out << name_ << " (grid " << dims_[0] << "x" << dims_[1] << "x" << dims_[2] << ", spacing " << h_.x() << ","
+      << h_.y() << "," << h_.z() << "; tricubic Catmull-Rom of d^2; "
+      << (gradient_.empty() ? "analytic gradient" : "given gradient") << "; domain " << FormatBox(box_) << " from "
+      << box_source_ << ")";
+  return out.str();
+}
+
+}  // namespace voroudf

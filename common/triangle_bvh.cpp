@@ -1,0 +1,315 @@
+#include "common/triangle_bvh.h"
+
+#include <algorithm>
+#include <cassert>
+#include <cmath>
+#include <limits>
+
+namespace voroudf {
+namespace {
+
+// A triangle whose corner angle at `a` has sin^2 below this is treated as its three edges. The choice
+// balances two errors of ~1e-5 of the edge length at the threshold: the segment fallback is off by at
+// most the triangle's smallest altitude (<= L sin), while Ericson's face-region barycentrics lose
+// about eps / sin^2 to cancellation.
+constexpr double kDegenerateSin2 = 1e-10;
+constexpr int kBins = 16;
+// Past this depth the build splits at the median, so the traversal stack (kStackSize) never overflows.
+constexpr int kMedianDepth = 96;
+constexpr int kStackSize = 128;
+
+Vec3 ClosestOnSegment(const Vec3& p, const Vec3& a, const Vec3& b) {
+  const Vec3 ab = b - a;
+  const double len2 = ab.squaredNorm();
+  if (!(len2 > 0.0)) return a;
+  const double t = std::clamp((p - a).dot(ab) / len2, 0.0, 1.0);
+  return a + t * ab;
+}
+
+Vec3 ClosestOnEdges(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
+  const Vec3 q[3] = {ClosestOnSegment(p, a, b), ClosestOnSegment(p, b, c), ClosestOnSegment(p, c, a)};
+  int best = 0;
+  double best_d = (p - q[0]).squaredNorm();
+  for (int k = 1; k < 3; ++k) {
+    const double d = (p - q[k]).squaredNorm();
+    if (d < best_d) best_d = d, best = k;
+  }
+  return q[best];
+}
+
+// Barycentric (v, w) of the closest point a + v ab + w ac (Ericson, Sec. 5.1.5), written with the
+// precomputed d00 = ab.ab, d01 = ab.ac, d11 = ac.ac so that a query costs two dot products: with
+// d1 = ab.ap and d2 = ac.ap, Ericson's d3..d6 are d1 - d00, d2 - d01, d1 - d01 and d2 - d11.
+// Every denominator is d00, d11, |bc|^2 or det = d00 d11 - d01^2, all positive for a non-degenerate triangle.
+inline void EricsonBarycentric(double d1, double d2, double d00, double d01, double d11, double inv_det, double* v,
+                               double* w) {
+  if (d1 <= 0.0 && d2 <= 0.0) { *v = 0.0; *w = 0.0; return; }  // vertex a
+  const double d3 = d1 - d00, d4 = d2 - d01;
+  if (d3 >= 0.0 && d4 <= d3) { *v = 1.0; *w = 0.0; return; }  // vertex b
+  const double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0) { *v = std::min(d1 / d00, 1.0); *w = 0.0; return; }  // edge ab
+  const double d5 = d1 - d01, d6 = d2 - d11;
+  if (d6 >= 0.0 && d5 <= d6) { *v = 0.0; *w = 1.0; return; }  // vertex c
+  const double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0) { *v = 0.0; *w = std::min(d2 / d11, 1.0); return; }  // edge ac
+  const double va = d3 * d6 - d5 * d4;
+  const double e43 = d4 - d3, e56 = d5 - d6;
+  if (va <= 0.0 && e43 >= 0.0 && e56 >= 0.0) {  // edge bc; e43 + e56 = |bc|^2 > 0
+    const double t = std::min(e43 / (e43 + e56), 1.0);
+    *v = 1.0 - t;
+    *w = t;
+    return;
+  }
+  *v = vb * inv_det;  // face interior; va + vb + vc = det
+  *w = vc * inv_det;
+}
+
+float RoundDown(double x) {
+  float f = static_cast<float>(x);
+  if (static_cast<double>(f) > x) f = std::nextafter(f, -std::numeric_limits<float>::infinity());
+  return f;
+}
+float RoundUp(double x) {
+  float f = static_cast<float>(x);
+  if (static_cast<double>(f) < x) f = std::nextafter(f, std::numeric_limits<float>::infinity());
+  return f;
+}
+
+double SurfaceArea(const Eigen::AlignedBox3d& b) {
+  if (b.isEmpty()) return 0.0;
+  const Vec3 e = b.sizes();
+  return e.x() * e.y() + e.y() * e.z() + e.z() * e.x();
+}
+
+}  // namespace
+
+Vec3 ClosestPointOnTriangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
+  const Vec3 ab = b - a, ac = c - a;
+  const double d00 = ab.dot(ab), d01 = ab.dot(ac), d11 = ac.dot(ac);
+  const double det = d00 * d11 - d01 * d01;
+  if (!(d00 > 0.0) || !(d11 > 0.0) || !(det > kDegenerateSin2 * d00 * d11) || !((c - b).squaredNorm() > 0.0))
+    return ClosestOnEdges(p, a, b, c);
+  const Vec3 ap = p - a;
+  double v, w;
+  EricsonBarycentric(ab.dot(ap), ac.dot(ap), d00, d01, d11, 1.0 / det, &v, &w);
+  return a + v * ab + w * ac;
+}
+
+TriangleBvh::TriangleBvh(const std::vector<Vec3>& vertices, const std::vector<Tri>& faces) {
+  assert(!faces.empty());
+  const int n = static_cast<int>(faces.size());
+  std::vector<Vec3> centroid(n);
+  std::vector<Eigen::AlignedBox3d> box(n);
+  normal_.resize(n);
+  for (int f = 0; f < n; ++f) {
+    const Vec3& a = vertices[faces[f][0]];
+    const Vec3& b = vertices[faces[f][1]];
+    const Vec3& c = vertices[faces[f][2]];
+    centroid[f] = (a + b + c) / 3.0;
+    box[f] = Eigen::AlignedBox3d(a);
+    box[f].extend(b).extend(c);
+    const Vec3 nrm = (b - a).cross(c - a);
+    const double len = nrm.norm();
+    if (len > 0.0 && std::isfinite(len)) {
+      normal_[f] = nrm / len;
+    } else {
+      // Degenerate: orthogonal to the longest edge, deterministic.
+      Vec3 e = b - a;
+      if ((c - b).squaredNorm() > e.squaredNorm()) e = c - b;
+      if ((a - c).squaredNorm() > e.squaredNorm()) e = a - c;
+      if (e.squaredNorm() > 0.0) {
+        Eigen::Index axis;
+        e.cwiseAbs().minCoeff(&axis);
+        normal_[f] = e.cross(Vec3::Unit(axis)).normalized();
+      } else {
+        normal_[f] = Vec3::UnitZ();
+      }
+    }
+  }
+  std::vector<int> order(n);
+  for (int f = 0; f < n; ++f) order[f] = f;
+  nodes_.reserve(2 * static_cast<size_t>(n));
+  tris_.reserve(n);
+  face_of_.reserve(n);
+  Build(order, 0, n, centroid, box, 0);
+
+  for (int slot = 0; slot < n; ++slot) {
+    const Tri& t = faces[face_of_[slot]];
+    const Vec3& a = vertices[t[0]];
+    const Vec3 ab = vertices[t[1]] - a, ac = vertices[t[2]] - a;
+    PackedTri& pt = tris_.emplace_back();
+    for (int k = 0; k < 3; ++k) pt.a[k] = a[k], pt.ab[k] = ab[k], pt.ac[k] = ac[k];
+    pt.d00 = ab.dot(ab);
+    pt.d01 = ab.dot(ac);
+    pt.d11 = ac.dot(ac);
+    const double det = pt.d00 * pt.d11 - pt.d01 * pt.d01;
+    const bool ok = pt.d00 > 0.0 && pt.d11 > 0.0 && det > kDegenerateSin2 * pt.d00 * pt.d11 &&
+                    (ac - ab).squaredNorm() > 0.0;
+    pt.inv_det = ok ? 1.0 / det : 0.0;
+    if (!ok) ++num_degenerate_;
+  }
+}
+
+int TriangleBvh::Build(std::vector<int>& order, int begin, int end, const std::vector<Vec3>& centroid,
+                       const std::vector<Eigen::AlignedBox3d>& box, int depth) {
+  depth_ = std::max(depth_, depth + 1);
+  const int node = static_cast<int>(nodes_.size());
+  nodes_.emplace_back();
+  Eigen::AlignedBox3d bounds, cbounds;
+  for (int i = begin; i < end; ++i) {
+    bounds.extend(box[order[i]]);
+    cbounds.extend(centroid[order[i]]);
+  }
+  for (int k = 0; k < 3; ++k) {
+    nodes_[node].lo[k] = RoundDown(bounds.min()[k]);
+    nodes_[node].hi[k] = RoundUp(bounds.max()[k]);
+  }
+  const int count = end - begin;
+  if (count <= kMaxLeafSize) {
+    nodes_[node].index = static_cast<int32_t>(face_of_.size());
+    nodes_[node].count = count;
+    for (int i = begin; i < end; ++i) face_of_.push_back(order[i]);
+    return node;
+  }
+
+  // Binned SAH over the three axes (Wald 2007); the median split when the centroids coincide along
+  // every axis (duplicate faces) or the tree is already deep.
+  int best_axis = -1, best_split = -1;
+  double best_cost = std::numeric_limits<double>::infinity();
+  const Vec3 cext = cbounds.sizes();
+  if (depth < kMedianDepth) {
+    for (int axis = 0; axis < 3; ++axis) {
+      if (!(cext[axis] > 0.0)) continue;
+      const double scale = kBins / cext[axis];
+      Eigen::AlignedBox3d bin_box[kBins];
+      int bin_count[kBins] = {0};
+      for (int i = begin; i < end; ++i) {
+        const int b = std::min(kBins - 1, static_cast<int>((centroid[order[i]][axis] - cbounds.min()[axis]) * scale));
+        bin_box[b].extend(box[order[i]]);
+        ++bin_count[b];
+      }
+      double right_area[kBins];
+      int right_count[kBins];
+      Eigen::AlignedBox3d acc;
+      int cnt = 0;
+      for (int b = kBins - 1; b > 0; --b) {
+        acc.extend(bin_box[b]);
+        cnt += bin_count[b];
+        right_area[b] = SurfaceArea(acc);
+        right_count[b] = cnt;
+      }
+      acc.setEmpty();
+      cnt = 0;
+      for (int b = 0; b < kBins - 1; ++b) {
+        acc.extend(bin_box[b]);
+        cnt += bin_count[b];
+        if (cnt == 0 || right_count[b + 1] == 0) continue;
+        const double cost = SurfaceArea(acc) * cnt + right_area[b + 1] * right_count[b + 1];
+        if (cost < best_cost) best_cost = cost, best_axis = axis, best_split = b;
+      }
+    }
+  }
+  int mid;
+  if (best_axis >= 0) {
+    const double scale = kBins / cext[best_axis];
+    const double lo = cbounds.min()[best_axis];
+    const auto it = std::partition(order.begin() + begin, order.begin() + end, [&](int f) {
+      return std::min(kBins - 1, static_cast<int>((centroid[f][best_axis] - lo) * scale)) <= best_split;
+    });
+    mid = static_cast<int>(it - order.begin());
+  } else {
+    Eigen::Index axis;
+    cext.maxCoeff(&axis);
+    mid = begin + count / 2;
+    std::nth_element(order.begin() + begin, order.begin() + mid, order.begin() + end,
+                     [&](int a, int b) { return centroid[a][axis] < centroid[b][axis] || (centroid[a][axis] == centroid[b][axis] && a < b); });
+  }
+  Build(order, begin, mid, centroid, box, depth + 1);
+  const int right = Build(order, mid, end, centroid, box, depth + 1);
+  nodes_[node].index = right;
+  nodes_[node].count = 0;
+  return node;
+}
+
+namespace {
+
+inline double BoxSqDistance(const float* lo, const float* hi, double px, double py, double pz) {
+  const double dx = std::max({static_cast<double>(lo[0]) - px, 0.0, px - static_cast<double>(hi[0])});
+  const double dy = std::max({static_cast<double>(lo[1]) - py, 0.0, py - static_cast<double>(hi[1])});
+  const double dz = std::max({static_cast<double>(lo[2]) - pz, 0.0, pz - static_cast<double>(hi[2])});
+  return dx * dx + dy * dy + dz * dz;
+}
+
+}  // namespace
+
+TriangleBvh::Hit TriangleBvh::Closest(const Vec3& p) const {
+  const double px = p.x(), py = p.y(), pz = p.z();
+  double best = std::numeric_limits<double>::infinity();
+  double bx = 0, by = 0, bz = 0;
+  int best_slot = -1;
+
+  struct Entry {
+    int node;
+    double sq;
+  };
+  Entry stack[kStackSize];
+  int top = 0;
+  int node = 0;
+  for (;;) {
+    const Node& nd = nodes_[node];
+    if (nd.count > 0) {
+      for (int s = nd.index, e = nd.index + nd.count; s < e; ++s) {
+        const PackedTri& t = tris_[s];
+        const double apx = px - t.a[0], apy = py - t.a[1], apz = pz - t.a[2];
+        double qx, qy, qz;
+        if (t.inv_det != 0.0) {
+          const double d1 = t.ab[0] * apx + t.ab[1] * apy + t.ab[2] * apz;
+          const double d2 = t.ac[0] * apx + t.ac[1] * apy + t.ac[2] * apz;
+          double v, w;
+          EricsonBarycentric(d1, d2, t.d00, t.d01, t.d11, t.inv_det, &v, &w);
+          qx = t.a[0] + v * t.ab[0] + w * t.ac[0];
+          qy = t.a[1] + v * t.ab[1] + w * t.ac[1];
+          qz = t.a[2] + v * t.ab[2] + w * t.ac[2];
+        } else {
+          const Vec3 a(t.a[0], t.a[1], t.a[2]);
+          const Vec3 q = ClosestOnEdges(p, a, a + Vec3(t.ab[0], t.ab[1], t.ab[2]), a + Vec3(t.ac[0], t.ac[1], t.ac[2]));
+          qx = q.x(), qy = q.y(), qz = q.z();
+        }
+        const double dx = px - qx, dy = py - qy, dz = pz - qz;
+        const double sq = dx * dx + dy * dy + dz * dz;
+        if (sq < best) best = sq, bx = qx, by = qy, bz = qz, best_slot = s;
+      }
+    } else {
+      const int left = node + 1, right = nd.index;
+      const double dl = BoxSqDistance(nodes_[left].lo, nodes_[left].hi, px, py, pz);
+      const double dr = BoxSqDistance(nodes_[right].lo, nodes_[right].hi, px, py, pz);
+      const bool left_first = dl <= dr;
+      const int near = left_first ? left : right, far = left_first ? right : left;
+      const double dnear = left_first ? dl : dr, dfar = left_first ? dr : dl;
+      if (dnear < best) {
+        if (dfar < best) stack[top++] = {far, dfar};
+        node = near;
+        continue;
+      }
+    }
+    // Pop the next box that can still hold something closer.
+    for (;;) {
+      if (top == 0) {
+        Hit hit;
+        hit.sq_distance = best;
+        hit.point = Vec3(bx, by, bz);
+        hit.face = best_slot >= 0 ? face_of_[best_slot] : -1;
+        return hit;
+      }
+      const Entry e = stack[--top];
+      if (e.sq < best) {
+        node = e.node;
+        break;
+      }
+    }
+  }
+}
+
+Vec3 TriangleBvh::FaceNormal(int face) const { return normal_[face]; }
+
+}  // namespace voroudf
