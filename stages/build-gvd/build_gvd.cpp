@@ -1,0 +1,366 @@
+#include "stages/build-gvd/build_gvd.h"
+
+#include <flann/flann.hpp>
+#include <omp.h>
+
+#include <algorithm>
+#include <cstdarg>
+#include <limits>
+#include <cmath>
+#include <cstdio>
+#include <functional>
+#include <numeric>
+#include <queue>
+#include <utility>
+
+#include "common/errors.h"
+#include "common/projection.h"
+#include "common/rng.h"
+
+namespace voroudf {
+namespace {
+
+std::string Format(const char* fmt, ...) __attribute__((format(printf, 1, 2)));
+std::string Format(const char* fmt, ...) {
+  char buf[512];
+  va_list args;
+  va_start(args, fmt);
+  std::vsnprintf(buf, sizeof buf, fmt, args);
+  va_end(args);
+  return buf;
+}
+
+/// Spreads the low 21 bits of x so that two zero bits follow each one.
+uint64_t Spread3(uint64_t x) {
+  x &= 0x1fffff;
+  x = (x | x << 32) & 0x1f00000000ffffull;
+  x = (x | x << 16) & 0x1f0000ff0000ffull;
+  x = (x | x << 8) & 0x100f00f00f00f00full;
+  x = (x | x << 4) & 0x10c30c30c30c30c3ull;
+  x = (x | x << 2) & 0x1249249249249249ull;
+  return x;
+}
+
+/// Exact k nearest neighbours of every point among `points` (itself excluded), k' = min(k, n-1) per point,
+/// in increasing distance (FLANN's single kd-tree: exact, and its answers do not depend on the threads).
+/// Returns a row-major n x k' table.
+std::vector<int> KNearest(const std::vector<Vec3>& points, int k, int* k_out, Monitor& monitor,
+                          const std::string& task_name) {
+  const size_t n = points.size();
+  const int kk = static_cast<int>(std::min<size_t>(static_cast<size_t>(k), n > 0 ? n - 1 : 0));
+  *k_out = kk;
+  std::vector<int> result(n * static_cast<size_t>(kk), -1);
+  if (kk == 0) return result;
+  // FLANN wants a contiguous row-major matrix; Vec3 is three packed doubles.
+  std::vector<double> flat(3 * n);
+  for (size_t i = 0; i < n; ++i)
+    for (int c = 0; c < 3; ++c) flat[3 * i + c] = points[i][c];
+  flann::Matrix<double> data(flat.data(), n, 3);
+  flann::Index<flann::L2_Simple<double>> index(data, flann::KDTreeSingleIndexParams(12));
+  index.buildIndex();
+
+  // Chunks bound the memory of FLANN's result matrices; k + 1 because every point finds itself.
+  const size_t chunk = 32768;
+  const int kq = kk + 1;
+  std::vector<size_t> idx(chunk * static_cast<size_t>(kq));
+  std::vector<double> dist(chunk * static_cast<size_t>(kq));
+  flann::SearchParams params(flann::FLANN_CHECKS_UNLIMITED);
+  params.cores = omp_get_max_threads();
+  params.sorted = true;
+  Task task(monitor, task_name, n);
+  for (size_t begin = 0; begin < n; begin += chunk) {
+    const size_t m = std::min(chunk, n - begin);
+    flann::Matrix<double> queries(flat.data() + 3 * begin, m, 3);
+    flann::Matrix<size_t> mi(idx.data(), m, static_cast<size_t>(kq));
+    flann::Matrix<double> md(dist.data(), m, static_cast<size_t>(kq));
+    index.knnSearch(queries, mi, md, static_cast<size_t>(kq), params);
+    for (size_t q = 0; q < m; ++q) {
+      const size_t self = begin + q;
+      int filled = 0;
+      for (int j = 0; j < kq && filled < kk; ++j) {
+        const size_t other = mi[q][j];
+        if (other == self || other >= n) continue;
+        result[self * static_cast<size_t>(kk) + static_cast<size_t>(filled++)] = static_cast<int>(other);
+      }
+    }
+    task.Advance(m);
+  }
+  return result;
+}
+
+}  // namespace
+
+void BuildGvdOptions::Check() const {
+  if (!(samples_per_seed >= 1.0 && samples_per_seed <= 1e5)) throw UsageError("--samples-per-seed must be in [1, 1e5]");
+  if (!(space_fraction >= 0.0 && space_fraction <= 1.0)) throw UsageError("--space-fraction must be in [0, 1]");
+  if (!(ball_scale > 0.0 && ball_scale <= 100.0)) throw UsageError("--ball-scale must be in (0, 100]");
+  if (knn < 3 || knn > 200) throw UsageError("--knn must be in [3, 200]");
+  if (!(eps_udf_rel > 0.0 && eps_udf_rel < 1.0)) throw UsageError("--eps-udf-rel must be in (0, 1)");
+  if (!(eps_grad > 0.0 && eps_grad <= 1.0)) throw UsageError("--eps-grad must be in (0, 1]");
+  if (!(proj_tol_rel > 0.0 && proj_tol_rel < 0.1)) throw UsageError("--proj-tol-rel must be in (0, 0.1)");
+  if (proj_max_iters < 1) throw UsageError("--proj-max-iters must be at least 1");
+}
+
+uint64_t MortonCode(const Vec3& p, const Box& box) {
+  uint64_t code = 0;
+  for (int c = 0; c < 3; ++c) {
+    const double extent = box.max[c] - box.min[c];
+    double t = extent > 0 ? (p[c] - box.min[c]) / extent : 0.0;
+    t = std::min(std::max(t, 0.0), 1.0);
+    const uint64_t q = std::min<uint64_t>(static_cast<uint64_t>(t * 2097152.0), 2097151);
+    code |= Spread3(q) << c;
+  }
+  return code;
+}
+
+GvdResult BuildGvd(const Udf& udf, const SeedCloud& seeds, const BuildGvdOptions& options, bool with_graph,
+                   Monitor& monitor) {
+  options.Check();
+  const size_t num_seeds = seeds.size();
+  if (num_seeds == 0) throw InputError("the seeds file has no seeds");
+  if (num_seeds > static_cast<size_t>(std::numeric_limits<int>::max() / 4))
+    throw InputError("too many seeds for 32-bit mesh indices");
+  const Box box = udf.Domain();
+  const double diag = box.Diagonal();
+  GvdResult result;
+  BuildGvdStats& stats = result.stats;
+
+  // 1. Dense samples. Ball radius per seed: the distance to its 6th-nearest seed (one ring of neighbours
+  // on a sheet), so the balls overlap and adapt to the local seed density; capped for isolated seeds.
+  int k_seeds = 0;
+  const std::vector<int> seed_nn = KNearest(seeds.position, 6, &k_seeds, Monitor::Null(), "seed neighbours");
+  std::vector<double> radius(num_seeds, 0.05 * diag);
+  for (size_t i = 0; i < num_seeds && k_seeds > 0; ++i) {
+    const int far = seed_nn[i * static_cast<size_t>(k_seeds) + static_cast<size_t>(k_seeds - 1)];
+    radius[i] = std::min(0.1 * diag, options.ball_scale * (seeds.position[static_cast<size_t>(far)] - seeds.position[i]).norm());
+    if (!(radius[i] > 0.0)) radius[i] = 1e-4 * diag;  // coincident seeds
+  }
+  const size_t total = static_cast<size_t>(std::llround(options.samples_per_seed * static_cast<double>(num_seeds)));
+  const size_t in_space = static_cast<size_t>(std::llround(options.space_fraction * static_cast<double>(total)));
+  std::vector<Vec3> samples(total);
+#pragma omp parallel for schedule(static)
+  for (long li = 0; li < static_cast<long>(total); ++li) {
+    const size_t i = static_cast<size_t>(li);
+    Rng rng(options.seed, i);
+    if (i < in_space) {
+      for (int c = 0; c < 3; ++c) samples[i][c] = rng.Uniform(box.min[c], box.max[c]);
+      continue;
+    }
+    // Ball samples are dealt to the seeds round-robin so every seed gets the same share (+-1).
+    const size_t s = (i - in_space) % num_seeds;
+    Vec3 u;
+    do {
+      for (int c = 0; c < 3; ++c) u[c] = rng.Uniform(-1.0, 1.0);
+    } while (u.squaredNorm() > 1.0);
+    samples[i] = seeds.position[s] + radius[s] * u;
+  }
+  stats.samples_drawn = total;
+  ProjectionOptions proj;
+  proj.tolerance = options.proj_tol_rel * diag;
+  proj.max_iterations = options.proj_max_iters;
+  const ProjectionResult projected = ProjectToZeroSet(udf, samples, proj, monitor);
+  stats.samples_projected = projected.num_converged;
+
+  // 2. Nodes: seeds first (so that they win Morton-cell ties), then converged samples.
+  std::vector<Vec3> raw;
+  raw.reserve(num_seeds + projected.num_converged);
+  raw.insert(raw.end(), seeds.position.begin(), seeds.position.end());
+  for (size_t i = 0; i < total; ++i)
+    if (projected.converged[i]) raw.push_back(samples[i]);
+  std::vector<uint64_t> code(raw.size());
+#pragma omp parallel for schedule(static)
+  for (long i = 0; i < static_cast<long>(raw.size()); ++i) code[static_cast<size_t>(i)] = MortonCode(raw[static_cast<size_t>(i)], box);
+  std::vector<size_t> order(raw.size());
+  std::iota(order.begin(), order.end(), size_t{0});
+  std::sort(order.begin(), order.end(), [&](size_t a, size_t b) { return code[a] != code[b] ? code[a] < code[b] : a < b; });
+  std::vector<Vec3> node;
+  std::vector<int> node_seed;  // seed index of a seed node, -1 for a sample
+  node.reserve(raw.size());
+  node_seed.reserve(raw.size());
+  for (size_t k = 0; k < order.size(); ++k) {
+    const size_t r = order[k];
+    const bool is_seed = r < num_seeds;
+    if (k > 0 && code[order[k - 1]] == code[r]) {
+      // A seed on top of an earlier seed would only add zero-area triangles and a second layer of faces.
+      ++(is_seed ? stats.seeds_duplicate : stats.samples_duplicate);
+      continue;
+    }
+    node.push_back(raw[r]);
+    node_seed.push_back(is_seed ? static_cast<int>(r) : -1);
+  }
+  const size_t n = node.size();
+  stats.nodes = n;
+  if (stats.seeds_duplicate > 0)
+    monitor.Warn(Format("%zu seeds coincide with an earlier seed (same 2^-21 Morton cell) and are left out",
+                        stats.seeds_duplicate));
+  monitor.Info(Format("%zu dense samples drawn (%zu in the box, %zu around seeds), %zu on the zero set, "
+                      "%zu duplicates dropped; graph of %zu nodes (%zu seeds)",
+                      total, in_space, total - in_space, stats.samples_projected, stats.samples_duplicate, n,
+                      num_seeds - stats.seeds_duplicate));
+
+  // Gradients at the nodes (on the zero set this is a surface normal of either orientation).
+  std::vector<double> node_d;
+  std::vector<Vec3> node_n;
+  udf.Evaluate(node, node_d, node_n);
+
+  // 3. kNN graph, undirected, pruned.
+  int kk = 0;
+  const std::vector<int> knn = KNearest(node, options.knn, &kk, monitor, "kNN graph");
+  std::vector<std::pair<int, int>> edges;
+  edges.reserve(n * static_cast<size_t>(kk));
+  for (size_t i = 0; i < n; ++i)
+    for (int j = 0; j < kk; ++j) {
+      const int o = knn[i * static_cast<size_t>(kk) + static_cast<size_t>(j)];
+      if (o < 0) continue;
+      const int a = static_cast<int>(i);
+      edges.emplace_back(std::min(a, o), std::max(a, o));
+    }
+  std::sort(edges.begin(), edges.end());
+  edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
+  stats.edges_knn = edges.size();
+  std::vector<Vec3> mid(edges.size());
+#pragma omp parallel for schedule(static)
+  for (long e = 0; e < static_cast<long>(edges.size()); ++e) {
+    const auto& ed = edges[static_cast<size_t>(e)];
+    mid[static_cast<size_t>(e)] = 0.5 * (node[static_cast<size_t>(ed.first)] + node[static_cast<size_t>(ed.second)]);
+  }
+  std::vector<double> mid_d;
+  std::vector<Vec3> mid_n;
+  udf.Evaluate(mid, mid_d, mid_n);
+  std::vector<Vec3>().swap(mid);
+  std::vector<Vec3>().swap(mid_n);
+  const double eps_udf = options.eps_udf_rel * diag;
+  std::vector<char> keep(edges.size(), 0);
+  size_t pruned_udf = 0, pruned_grad = 0;
+#pragma omp parallel for schedule(static) reduction(+ : pruned_udf, pruned_grad)
+  for (long le = 0; le < static_cast<long>(edges.size()); ++le) {
+    const size_t e = static_cast<size_t>(le);
+    const size_t a = static_cast<size_t>(edges[e].first), b = static_cast<size_t>(edges[e].second);
+    if (!(mid_d[e] <= eps_udf)) {
+      ++pruned_udf;
+      continue;
+    }
+    const Vec3 dir = node[b] - node[a];
+    const double len = dir.norm();
+    if (len > 0.0) {
+      const double ca = std::abs(node_n[a].dot(dir)) / len, cb = std::abs(node_n[b].dot(dir)) / len;
+      if (ca > options.eps_grad || cb > options.eps_grad) {
+        ++pruned_grad;
+        continue;
+      }
+    }
+    keep[e] = 1;
+  }
+  stats.edges_pruned_udf = pruned_udf;
+  stats.edges_pruned_grad = pruned_grad;
+  // Adjacency in CSR form; neighbour lists come out sorted because `edges` is.
+  std::vector<size_t> offset(n + 1, 0);
+  for (size_t e = 0; e < edges.size(); ++e)
+    if (keep[e]) {
+      ++offset[static_cast<size_t>(edges[e].first) + 1];
+      ++offset[static_cast<size_t>(edges[e].second) + 1];
+    }
+  for (size_t i = 0; i < n; ++i) offset[i + 1] += offset[i];
+  std::vector<int> adj(offset[n]);
+  {
+    std::vector<size_t> fill(offset.begin(), offset.end() - 1);
+    for (size_t e = 0; e < edges.size(); ++e)
+      if (keep[e]) {
+        adj[fill[static_cast<size_t>(edges[e].first)]++] = edges[e].second;
+        adj[fill[static_cast<size_t>(edges[e].second)]++] = edges[e].first;
+      }
+    for (size_t i = 0; i < n; ++i) std::sort(adj.begin() + static_cast<long>(offset[i]), adj.begin() + static_cast<long>(offset[i + 1]));
+  }
+  const size_t kept_edges = offset[n] / 2;
+  monitor.Info(Format("kNN graph (k=%d): %zu edges; pruned %zu with midpoint UDF > %.3g, %zu with |cos(edge, "
+                      "gradient)| > %.3g; %zu left",
+                      kk, stats.edges_knn, pruned_udf, eps_udf, pruned_grad, options.eps_grad, kept_edges));
+
+  // 4. Multi-source Dijkstra, hand-written (a binary heap over (distance, node) pairs): no installed library
+  // runs a multi-source sweep that also records the source. Sequential, hence deterministic.
+  std::vector<double> dist(n, INFINITY);
+  std::vector<int> label(n, -1);
+  using Item = std::pair<double, int>;
+  std::priority_queue<Item, std::vector<Item>, std::greater<Item>> heap;
+  for (size_t i = 0; i < n; ++i)
+    if (node_seed[i] >= 0) {
+      dist[i] = 0.0;
+      label[i] = node_seed[i];
+      heap.emplace(0.0, static_cast<int>(i));
+    }
+  {
+    Task task(monitor, "geodesic sweep", n);
+    while (!heap.empty()) {
+      const auto [du, u] = heap.top();
+      heap.pop();
+      const size_t su = static_cast<size_t>(u);
+      if (du > dist[su]) continue;
+      task.Advance(1);
+      for (size_t a = offset[su]; a < offset[su + 1]; ++a) {
+        const size_t v = static_cast<size_t>(adj[a]);
+        const double dv = du + (node[v] - node[su]).norm();
+        if (dv < dist[v]) {
+          dist[v] = dv;
+          label[v] = label[su];
+          heap.emplace(dv, static_cast<int>(v));
+        }
+      }
+    }
+  }
+  for (size_t i = 0; i < n; ++i) stats.unreached += label[i] < 0 ? 1 : 0;
+  if (stats.unreached > 0)
+    monitor.Warn(Format("%zu of %zu samples are not reached from any seed (label -1)", stats.unreached, n));
+
+  // 5. Dual triangles. Per thread lists, then one sort: the result does not depend on the scheduling.
+  std::vector<std::vector<Tri>> per_thread(static_cast<size_t>(omp_get_max_threads()));
+#pragma omp parallel
+  {
+    std::vector<Tri>& out = per_thread[static_cast<size_t>(omp_get_thread_num())];
+    std::vector<int> others;
+#pragma omp for schedule(dynamic, 1024)
+    for (long li = 0; li < static_cast<long>(n); ++li) {
+      const size_t u = static_cast<size_t>(li);
+      const int i = label[u];
+      if (i < 0) continue;
+      others.clear();
+      for (size_t a = offset[u]; a < offset[u + 1]; ++a) {
+        const int l = label[static_cast<size_t>(adj[a])];
+        if (l >= 0 && l != i) others.push_back(l);
+      }
+      std::sort(others.begin(), others.end());
+      others.erase(std::unique(others.begin(), others.end()), others.end());
+      for (size_t p = 0; p < others.size(); ++p)
+        for (size_t q = p + 1; q < others.size(); ++q) {
+          Tri t{i, others[p], others[q]};
+          std::sort(t.begin(), t.end());
+          out.push_back(t);
+        }
+    }
+  }
+  std::vector<Tri>& faces = result.thick.faces;
+  for (auto& v : per_thread) faces.insert(faces.end(), v.begin(), v.end());
+  std::sort(faces.begin(), faces.end());
+  faces.erase(std::unique(faces.begin(), faces.end()), faces.end());
+  stats.triangles = faces.size();
+  result.thick.vertices = seeds.position;
+  monitor.Info(Format("%zu dual triangles over %zu seeds", faces.size(), num_seeds));
+  if (faces.empty())
+    throw NumericalError("no dual triangle: the Voronoi regions of the seeds never meet three at a time (too few "
+                         "seeds, or the graph is pruned apart: check --eps-udf-rel and --eps-grad)");
+
+  LabeledSamples& ls = result.samples;
+  ls.position = std::move(node);
+  ls.label = std::move(label);
+  // Unreached nodes get -1: readers refuse non-finite values.
+  for (double& d : dist)
+    if (!std::isfinite(d)) d = -1.0;
+  ls.dist = std::move(dist);
+  if (with_graph) {
+    ls.edges.reserve(kept_edges);
+    for (size_t e = 0; e < edges.size(); ++e)
+      if (keep[e]) ls.edges.push_back({edges[e].first, edges[e].second});
+  }
+  return result;
+}
+
+}  // namespace voroudf

@@ -1,0 +1,92 @@
+#pragma once
+// Stage 3 (DESIGN.md; paper Sec. 3.3, "Mesh Reconstruction via the Dual of a Geodesic Voronoi Diagram"):
+// dense samples on the zero set, a pruned kNN graph over them, a multi-source geodesic sweep from the seeds,
+// and the dual triangles of the resulting (approximate) geodesic Voronoi diagram: the "thick" mesh that
+// thin-mesh then thins.
+#include <cstddef>
+#include <cstdint>
+
+#include "common/monitor.h"
+#include "common/types.h"
+#include "common/udf.h"
+#include "formats/labels_io.h"
+#include "formats/seeds_io.h"
+
+namespace voroudf {
+
+struct BuildGvdOptions {
+  /// Dense samples drawn per seed before projection (--samples-per-seed). The kNN graph spans about
+  /// sqrt(knn / samples_per_seed) seed spacings, and the wider it is, the more spurious 4-label junctions
+  /// (flat tetrahedra for thin-mesh) appear; 100 keeps it near a third of a spacing at ~1 s for 3k seeds.
+  double samples_per_seed = 100.0;
+  /// Fraction of the dense samples drawn uniformly in the domain box (--space-fraction); the rest are drawn
+  /// in balls around the seeds. Box samples project preferentially onto sharp edges, corners and open
+  /// boundaries (whole wedges of space project onto them), which is where the graph must connect sheets;
+  /// ball samples follow the seed density.
+  double space_fraction = 0.25;
+  /// Radius of the ball around each seed, as a multiple of the distance to its 6th-nearest seed (about one
+  /// seed spacing on a sheet) (--ball-scale).
+  double ball_scale = 1.0;
+  int knn = 20;  ///< neighbours per sample in the graph (--knn; paper: 20)
+  /// An edge is pruned when the UDF at its midpoint exceeds eps_udf_rel * domain diagonal (--eps-udf-rel).
+  double eps_udf_rel = 2e-3;
+  /// An edge is pruned when |cos(edge, gradient)| at either endpoint exceeds this (--eps-grad).
+  double eps_grad = 0.9;
+  uint64_t seed = 0;           ///< RNG seed of the dense samples (--seed)
+  double proj_tol_rel = 1e-5;  ///< samples converge once d < proj_tol_rel * diagonal (--proj-tol-rel)
+  int proj_max_iters = 50;     ///< projection steps before a sample is dropped (--proj-max-iters)
+
+  /// Throws UsageError for values that cannot work.
+  void Check() const;
+};
+
+/// What BuildGvd did, for logs and tests.
+struct BuildGvdStats {
+  size_t samples_drawn = 0;
+  size_t samples_projected = 0;   ///< converged onto the zero set
+  size_t samples_duplicate = 0;   ///< dropped because another node sits at (numerically) the same place
+  size_t seeds_duplicate = 0;     ///< seeds in the same Morton cell as an earlier seed, left out (no faces)
+  size_t nodes = 0;               ///< graph nodes: seeds + kept samples
+  size_t edges_knn = 0;           ///< undirected kNN edges before pruning
+  size_t edges_pruned_udf = 0;    ///< of those, pruned by the midpoint UDF test
+  size_t edges_pruned_grad = 0;   ///< pruned by the gradient test (and not by the UDF test)
+  size_t unreached = 0;           ///< nodes no seed reaches (label -1)
+  size_t triangles = 0;
+};
+
+struct GvdResult {
+  TriangleMesh thick;      ///< vertices = the seeds, in file order; faces sorted, each vertex triple once
+  LabeledSamples samples;  ///< every graph node (seeds included) in space-filling-curve order; edges if asked
+  BuildGvdStats stats;
+};
+
+/// Builds the approximate geodesic Voronoi diagram of `seeds` on the zero set of `udf` and its dual
+/// triangles (paper Sec. 3.3).
+///
+///  1. samples_per_seed * N points: a space_fraction of them uniform in udf.Domain(), the rest uniform in a
+///     ball around each seed; each projected with x <- x - d n (common/projection.h); unconverged ones dropped.
+///     Point i draws from the counter-based stream (seed, i), so the draw does not depend on the threads.
+///  2. The seeds join the samples as graph nodes (each labelled with its own index at distance 0: the seeds
+///     are the sources of the sweep). Nodes are sorted along a Morton curve; a sample that shares a Morton
+///     cell (2^-21 of the box) with an earlier node is dropped as a duplicate (whole wedges of space project
+///     onto the same corner point); so is a seed on top of an earlier seed (it gets no faces).
+///  3. kNN graph (FLANN, exact kd-tree, k = knn) made undirected; an edge is pruned when
+///     d(midpoint) > eps_udf_rel * diagonal or |cos(edge, n)| > eps_grad at either endpoint.
+///  4. Multi-source Dijkstra with Euclidean edge lengths labels every node with its geodesically nearest seed;
+///     unreachable nodes get label -1 and are counted.
+///  5. For every node labelled i and every two distinct labels j, k (both != i, both >= 0) among its graph
+///     neighbours, the triangle (i, j, k), each vertex triple once.
+///
+/// \param udf    the field; its domain box sets every relative length
+/// \param seeds  the sources (N >= 1), usually from optimize-seeds; only positions are used
+/// \param with_graph  also return the pruned edges in result.samples.edges (indices into result.samples)
+/// \pre options.Check() passes. Throws InputError when `seeds` is empty, NumericalError when no triangle results.
+/// Deterministic: the same inputs and options give the same result whatever the thread count.
+GvdResult BuildGvd(const Udf& udf, const SeedCloud& seeds, const BuildGvdOptions& options, bool with_graph,
+                   Monitor& monitor);
+
+/// Morton (Z-order) code of `p` in `box`, 21 bits per axis. Sorting points by it puts neighbours in space
+/// near each other in memory, which makes the kd-tree queries about twice as fast (DESIGN.md, measured).
+uint64_t MortonCode(const Vec3& p, const Box& box);
+
+}  // namespace voroudf

@@ -1,0 +1,45 @@
+// build-gvd: the dual of the approximate geodesic Voronoi diagram of the seeds (docs/build-gvd.md).
+#include "common/cli.h"
+#include "common/errors.h"
+#include "formats/mesh_io.h"
+#include "stages/build-gvd/build_gvd.h"
+
+int main(int argc, char** argv) {
+  voroudf::BuildGvdOptions options;
+  std::string udf_spec, input, output, labels;
+  bool ascii = false, graph = false;
+
+  voroudf::StageCli cli("build-gvd",
+                        "Labels dense zero-set samples with their geodesically nearest seed (Dijkstra over a pruned "
+                        "kNN graph) and writes the dual triangles of that Voronoi diagram: the thick mesh.");
+  cli.AddUdf(&udf_spec);
+  cli.AddInput(&input, "input seeds PLY (seeds.ply)");
+  cli.AddOutput(&output, "output thick mesh PLY, vertices = the seeds (thick.ply)");
+  cli.AddExtraOutput("--labels", &labels, "also write the labelled samples (labels PLY)");
+  cli.AddSeed(&options.seed);
+  cli.AddAscii(&ascii);
+  auto& app = cli.app();
+  app.add_flag("--graph", graph, "with --labels: also write the pruned kNN graph as an edge element");
+  app.add_option("--samples-per-seed", options.samples_per_seed, "dense samples drawn per seed");
+  app.add_option("--space-fraction", options.space_fraction, "fraction of dense samples drawn in the whole box");
+  app.add_option("--ball-scale", options.ball_scale, "ball radius around a seed / distance to its 6th-nearest seed");
+  app.add_option("--knn", options.knn, "neighbours per sample in the kNN graph");
+  app.add_option("--eps-udf-rel", options.eps_udf_rel, "prune edges with midpoint UDF above this x diagonal");
+  app.add_option("--eps-grad", options.eps_grad, "prune edges with |cos(edge, gradient)| above this at an end");
+  app.add_option("--proj-tol-rel", options.proj_tol_rel, "projection tolerance on d, relative to the diagonal");
+  app.add_option("--proj-max-iters", options.proj_max_iters, "projection steps before a sample is dropped");
+
+  return cli.Run(argc, argv, [&] { options.Check(); }, [&](voroudf::Monitor& monitor) {
+    const auto udf = voroudf::OpenUdf(udf_spec, cli.udf_options());
+    monitor.Info("UDF: " + udf->Describe());
+    const voroudf::SeedCloud seeds = voroudf::ReadSeeds(input);
+    if (seeds.size() == 0) throw voroudf::InputError(input, "the seeds file has no seeds");
+    const voroudf::GvdResult gvd = voroudf::BuildGvd(*udf, seeds, options, graph && !labels.empty(), monitor);
+    voroudf::WriteMeshPly(output, gvd.thick, cli.provenance(), ascii);
+    monitor.Info("wrote " + std::to_string(gvd.thick.faces.size()) + " faces to " + output);
+    if (!labels.empty()) {
+      voroudf::WriteLabels(labels, gvd.samples, cli.provenance(), ascii);
+      monitor.Info("wrote " + std::to_string(gvd.samples.size()) + " labelled samples to " + labels);
+    }
+  });
+}

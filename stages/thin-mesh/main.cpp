@@ -1,0 +1,38 @@
+// thin-mesh: thins the thick dual mesh of build-gvd into the final surface mesh (docs/thin-mesh.md).
+#include "common/cli.h"
+#include "formats/mesh_io.h"
+#include "stages/thin-mesh/thin_mesh.h"
+
+int main(int argc, char** argv) {
+  voroudf::ThinMeshOptions options;
+  std::string udf_spec, input, output, nm_edges;
+  bool ascii = false;
+
+  voroudf::StageCli cli("thin-mesh",
+                        "Removes face pairs from the closed tetrahedra of a thick mesh (the pair on a manifold edge "
+                        "whose centroids have the highest UDF), then small components; keeps non-manifold edges.");
+  cli.AddUdf(&udf_spec);
+  cli.AddInput(&input, "input thick mesh PLY (thick.ply from build-gvd)");
+  cli.AddOutput(&output, "output mesh PLY (mesh.ply)");
+  cli.AddExtraOutput("--nm-edges", &nm_edges, "also write the non-manifold edges (3+ faces) as an edges PLY");
+  cli.AddAscii(&ascii);
+  auto& app = cli.app();
+  app.add_option("--min-component-faces", options.min_component_faces,
+                 "components with fewer faces are removed (unless that opens a hole)");
+  app.add_option("--degenerate-area-rel", options.degenerate_area_rel,
+                 "faces with area at most this x diagonal^2 are dropped as degenerate");
+
+  return cli.Run(argc, argv, [&] { options.Check(); }, [&](voroudf::Monitor& monitor) {
+    const auto udf = voroudf::OpenUdf(udf_spec, cli.udf_options());
+    monitor.Info("UDF: " + udf->Describe());
+    const voroudf::TriangleMesh thick = voroudf::ReadMeshPly(input);
+    const voroudf::TriangleMesh mesh = voroudf::ThinMesh(*udf, thick, options, monitor);
+    voroudf::WriteMeshPly(output, mesh, cli.provenance(), ascii);
+    monitor.Info("wrote " + std::to_string(mesh.faces.size()) + " faces to " + output);
+    if (!nm_edges.empty()) {
+      const voroudf::EdgeSet edges = voroudf::NonManifoldEdges(mesh);
+      voroudf::WriteEdgesPly(nm_edges, edges, cli.provenance(), ascii);
+      monitor.Info("wrote " + std::to_string(edges.edges.size()) + " non-manifold edges to " + nm_edges);
+    }
+  });
+}

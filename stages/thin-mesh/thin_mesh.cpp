@@ -1,0 +1,365 @@
+#include "stages/thin-mesh/thin_mesh.h"
+
+#include <algorithm>
+#include <cstdio>
+#include <numeric>
+#include <unordered_map>
+#include <unordered_set>
+
+#include "common/errors.h"
+#include "common/mesh_topology.h"
+
+namespace voroudf {
+namespace {
+
+Tri Sorted(Tri t) {
+  std::sort(t.begin(), t.end());
+  return t;
+}
+
+struct TriHash {
+  size_t operator()(const Tri& t) const {
+    uint64_t h = static_cast<uint32_t>(t[0]);
+    h = h * 0x9E3779B97F4A7C15ull ^ static_cast<uint32_t>(t[1]);
+    h = h * 0x9E3779B97F4A7C15ull ^ static_cast<uint32_t>(t[2]);
+    return static_cast<size_t>(h ^ (h >> 29));
+  }
+};
+
+int Find(std::vector<int>& parent, int x) {
+  while (parent[static_cast<size_t>(x)] != x) {
+    parent[static_cast<size_t>(x)] = parent[static_cast<size_t>(parent[static_cast<size_t>(x)])];
+    x = parent[static_cast<size_t>(x)];
+  }
+  return x;
+}
+
+/// The mutable state of the thinning: faces, which are still present, and the valence of every edge.
+class Thinner {
+ public:
+  Thinner(std::vector<Tri> faces, std::vector<double> centroid_udf)
+      : faces_(std::move(faces)), udf_(std::move(centroid_udf)), alive_(faces_.size(), 1) {
+    incidence_ = BuildEdgeFaces(faces_);
+    valence_.resize(incidence_.edges.size());
+    for (size_t e = 0; e < valence_.size(); ++e) valence_[e] = static_cast<int>(incidence_.faces[e].size());
+    face_edges_.resize(faces_.size());
+    for (size_t f = 0; f < faces_.size(); ++f) {
+      const Tri& t = faces_[f];
+      face_edges_[f] = {incidence_.Find(t[0], t[1]), incidence_.Find(t[1], t[2]), incidence_.Find(t[2], t[0])};
+      by_vertices_.emplace(Sorted(t), static_cast<int>(f));
+    }
+  }
+
+  const std::vector<Tri>& faces() const { return faces_; }
+  const std::vector<char>& alive() const { return alive_; }
+
+  /// Closed tetrahedra among the present faces: for each, its 4 faces (abc, abd, acd, bcd with a<b<c<d),
+  /// sorted by the vertex quadruple.
+  std::vector<std::array<int, 4>> Tetrahedra() const {
+    std::vector<std::pair<std::array<int, 4>, std::array<int, 4>>> found;
+    for (size_t f = 0; f < faces_.size(); ++f) {
+      if (!alive_[f]) continue;
+      const Tri t = Sorted(faces_[f]);
+      const int a = t[0], b = t[1], c = t[2];
+      const int eab = incidence_.Find(a, b);
+      for (int g : incidence_.faces[static_cast<size_t>(eab)]) {
+        if (!alive_[static_cast<size_t>(g)] || g == static_cast<int>(f)) continue;
+        const Tri u = faces_[static_cast<size_t>(g)];
+        const int d = u[0] + u[1] + u[2] - a - b;  // the vertex of g that is not a or b
+        if (d <= c) continue;  // each tetrahedron once: from its face without the largest vertex
+        const int h1 = Present({a, c, d}), h2 = Present({b, c, d});
+        if (h1 < 0 || h2 < 0) continue;
+        found.push_back({{a, b, c, d}, {static_cast<int>(f), g, h1, h2}});
+      }
+    }
+    std::sort(found.begin(), found.end());
+    std::vector<std::array<int, 4>> tets;
+    tets.reserve(found.size());
+    for (const auto& p : found) tets.push_back(p.second);
+    return tets;
+  }
+
+  /// Fig. 8: removes the pair of faces of `tet` that share a manifold edge and whose centroids have the
+  /// largest summed UDF. Returns false (and removes nothing) when no pair shares a manifold edge.
+  bool ThinTetrahedron(const std::array<int, 4>& tet) {
+    for (int f : tet)
+      if (!alive_[static_cast<size_t>(f)]) return false;
+    int best_a = -1, best_b = -1, best_holes = 5;
+    double best = -1.0;
+    for (int p = 0; p < 4; ++p)
+      for (int q = p + 1; q < 4; ++q) {
+        const int fa = tet[static_cast<size_t>(p)], fb = tet[static_cast<size_t>(q)];
+        const int e = SharedEdge(fa, fb);
+        if (e < 0 || valence_[static_cast<size_t>(e)] != 2) continue;
+        // Edges of the pair other than the shared one that would be left with one face: inside a surface a
+        // tetrahedron's outer edges carry a face of the surface too, and the pair to remove is the one that
+        // leaves none open. Only then (and for a lone tetrahedron, where every pair opens 4) the UDF decides.
+        int holes = 0;
+        for (int f : {fa, fb})
+          for (int o : face_edges_[static_cast<size_t>(f)])
+            holes += (o != e && valence_[static_cast<size_t>(o)] == 2) ? 1 : 0;
+        const double score = udf_[static_cast<size_t>(fa)] + udf_[static_cast<size_t>(fb)];
+        if (holes < best_holes || (holes == best_holes && score > best)) {
+          best_holes = holes;
+          best = score;
+          best_a = fa;
+          best_b = fb;
+        }
+      }
+    if (best_a < 0) return false;
+    Remove(best_a);
+    Remove(best_b);
+    return true;
+  }
+
+  /// Components connected across manifold edges, as face lists (each in increasing face order): first those
+  /// with fewer than `min_faces` faces by decreasing mean centroid UDF, then the others by size.
+  std::vector<std::vector<int>> ManifoldComponents(size_t min_faces) const {
+    std::vector<int> parent(faces_.size());
+    std::iota(parent.begin(), parent.end(), 0);
+    for (size_t e = 0; e < valence_.size(); ++e) {
+      if (valence_[e] != 2) continue;
+      int first = -1;
+      for (int f : incidence_.faces[e]) {
+        if (!alive_[static_cast<size_t>(f)]) continue;
+        if (first < 0) {
+          first = f;
+        } else {
+          const int ra = Find(parent, first), rb = Find(parent, f);
+          parent[static_cast<size_t>(std::max(ra, rb))] = std::min(ra, rb);
+        }
+      }
+    }
+    std::unordered_map<int, size_t> slot;
+    std::vector<std::vector<int>> comps;
+    for (size_t f = 0; f < faces_.size(); ++f) {
+      if (!alive_[f]) continue;
+      const int r = Find(parent, static_cast<int>(f));
+      auto it = slot.find(r);
+      if (it == slot.end()) {
+        it = slot.emplace(r, comps.size()).first;
+        comps.emplace_back();
+      }
+      comps[it->second].push_back(static_cast<int>(f));
+    }
+    // Farthest from the surface (largest mean centroid UDF) first, as in Fig. 8: removing one side of a
+    // residual bubble makes the other side unsafe to remove, and the side to keep is the one on the surface.
+    std::vector<double> mean(comps.size(), 0.0);
+    for (size_t c = 0; c < comps.size(); ++c) {
+      for (int f : comps[c]) mean[c] += udf_[static_cast<size_t>(f)];
+      mean[c] /= static_cast<double>(comps[c].size());
+    }
+    std::vector<size_t> order(comps.size());
+    std::iota(order.begin(), order.end(), size_t{0});
+    std::stable_sort(order.begin(), order.end(), [&](size_t x, size_t y) {
+      const bool small_x = comps[x].size() < min_faces, small_y = comps[y].size() < min_faces;
+      if (small_x != small_y) return small_x;
+      if (small_x && mean[x] != mean[y]) return mean[x] > mean[y];
+      return comps[x].size() < comps[y].size();
+    });
+    std::vector<std::vector<int>> sorted(comps.size());
+    for (size_t k = 0; k < order.size(); ++k) sorted[k] = std::move(comps[order[k]]);
+    comps.swap(sorted);
+    return comps;
+  }
+
+  /// Removes `comp` unless that would leave one of its border edges with a single face (a new hole).
+  bool RemoveComponentIfSafe(const std::vector<int>& comp) {
+    std::unordered_map<int, int> uses;  // edge -> faces of comp on it
+    for (int f : comp) {
+      if (!alive_[static_cast<size_t>(f)]) return false;
+      for (int e : face_edges_[static_cast<size_t>(f)]) ++uses[e];
+    }
+    for (const auto& [e, c] : uses) {
+      const int v = valence_[static_cast<size_t>(e)];
+      if (c < v && v - c < 2) return false;
+    }
+    for (int f : comp) Remove(f);
+    return true;
+  }
+
+  /// Orients the faces of every manifold component consistently (breadth first from its first face), so that
+  /// viewers shade it smoothly. A non-orientable component keeps the first orientation each face receives.
+  void OrientComponents() {
+    std::vector<char> seen(faces_.size(), 0);
+    std::vector<int> queue;
+    for (size_t start = 0; start < faces_.size(); ++start) {
+      if (!alive_[start] || seen[start]) continue;
+      seen[start] = 1;
+      queue.assign(1, static_cast<int>(start));
+      for (size_t head = 0; head < queue.size(); ++head) {
+        const Tri& t = faces_[static_cast<size_t>(queue[head])];
+        for (int k = 0; k < 3; ++k) {
+          const int u = t[static_cast<size_t>(k)], w = t[static_cast<size_t>((k + 1) % 3)];
+          const int e = incidence_.Find(u, w);
+          if (valence_[static_cast<size_t>(e)] != 2) continue;
+          for (int g : incidence_.faces[static_cast<size_t>(e)]) {
+            if (!alive_[static_cast<size_t>(g)] || seen[static_cast<size_t>(g)]) continue;
+            Tri& s = faces_[static_cast<size_t>(g)];
+            // A consistent neighbour runs the shared edge the other way (w -> u).
+            for (int m = 0; m < 3; ++m)
+              if (s[static_cast<size_t>(m)] == u && s[static_cast<size_t>((m + 1) % 3)] == w) {
+                std::swap(s[0], s[1]);
+                break;
+              }
+            seen[static_cast<size_t>(g)] = 1;
+            queue.push_back(g);
+          }
+        }
+      }
+    }
+  }
+
+ private:
+  int Present(const Tri& sorted) const {
+    const auto it = by_vertices_.find(sorted);
+    return it != by_vertices_.end() && alive_[static_cast<size_t>(it->second)] ? it->second : -1;
+  }
+  int SharedEdge(int fa, int fb) const {
+    for (int e : face_edges_[static_cast<size_t>(fa)])
+      for (int o : face_edges_[static_cast<size_t>(fb)])
+        if (e == o) return e;
+    return -1;
+  }
+  void Remove(int f) {
+    alive_[static_cast<size_t>(f)] = 0;
+    for (int e : face_edges_[static_cast<size_t>(f)]) --valence_[static_cast<size_t>(e)];
+  }
+
+  std::vector<Tri> faces_;
+  std::vector<double> udf_;
+  std::vector<char> alive_;
+  EdgeFaces incidence_;
+  std::vector<int> valence_;  ///< present faces per edge
+  std::vector<std::array<int, 3>> face_edges_;
+  std::unordered_map<Tri, int, TriHash> by_vertices_;
+};
+
+std::string Count(size_t n, const char* what) { return std::to_string(n) + " " + what; }
+
+}  // namespace
+
+void ThinMeshOptions::Check() const {
+  if (min_component_faces > 1000000) throw UsageError("--min-component-faces must be at most 1e6");
+  if (!(degenerate_area_rel >= 0.0 && degenerate_area_rel < 1e-3))
+    throw UsageError("--degenerate-area-rel must be in [0, 1e-3)");
+}
+
+TriangleMesh ThinMesh(const Udf& udf, const TriangleMesh& thick, const ThinMeshOptions& options, Monitor& monitor,
+                      ThinMeshStats* stats_out) {
+  options.Check();
+  ThinMeshStats st;
+  const double diag = udf.Domain().Diagonal();
+  const double min_area = options.degenerate_area_rel * diag * diag;
+
+  // 0. Degenerate and duplicate faces.
+  std::vector<Tri> faces;
+  faces.reserve(thick.faces.size());
+  std::unordered_set<Tri, TriHash> seen;
+  for (const Tri& t : thick.faces) {
+    if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2]) {
+      ++st.degenerate_faces;
+      continue;
+    }
+    const Vec3& a = thick.vertices[static_cast<size_t>(t[0])];
+    const double area = 0.5 * (thick.vertices[static_cast<size_t>(t[1])] - a)
+                                  .cross(thick.vertices[static_cast<size_t>(t[2])] - a)
+                                  .norm();
+    if (!(area > min_area)) {
+      ++st.degenerate_faces;
+      continue;
+    }
+    if (!seen.insert(Sorted(t)).second) {
+      ++st.duplicate_faces;
+      continue;
+    }
+    faces.push_back(t);
+  }
+  monitor.Info(Count(thick.faces.size(), "faces in; dropped ") + Count(st.degenerate_faces, "degenerate and ") +
+               Count(st.duplicate_faces, "duplicate faces"));
+
+  std::vector<Vec3> centroid(faces.size());
+  for (size_t f = 0; f < faces.size(); ++f)
+    centroid[f] = (thick.vertices[static_cast<size_t>(faces[f][0])] + thick.vertices[static_cast<size_t>(faces[f][1])] +
+                   thick.vertices[static_cast<size_t>(faces[f][2])]) /
+                  3.0;
+  std::vector<double> centroid_udf;
+  std::vector<Vec3> centroid_grad;
+  udf.Evaluate(centroid, centroid_udf, centroid_grad);
+
+  Thinner thinner(std::move(faces), std::move(centroid_udf));
+  for (;;) {
+    ++st.rounds;
+    bool changed = false;
+    // 1. Tetrahedra, until a pass removes nothing (removing faces never creates a tetrahedron, but a pass
+    // can make an edge of a stuck tetrahedron manifold).
+    for (;;) {
+      const auto tets = thinner.Tetrahedra();
+      if (st.rounds == 1 && st.tetrahedra == 0) st.tetrahedra = tets.size();
+      size_t thinned = 0;
+      for (const auto& tet : tets) thinned += thinner.ThinTetrahedron(tet) ? 1 : 0;
+      st.tetrahedra_thinned += thinned;
+      monitor.Info("round " + std::to_string(st.rounds) + ": " + Count(tets.size(), "closed tetrahedra, ") +
+                   Count(thinned, "thinned (2 faces removed from each)"));
+      if (thinned == 0) break;
+      changed = true;
+    }
+    // 2. Small components, farthest from the surface first, until none can go.
+    for (;;) {
+      const auto comps = thinner.ManifoldComponents(options.min_component_faces);
+      size_t removed = 0, removed_faces = 0, small = 0;
+      for (const auto& comp : comps) {
+        if (comp.size() >= options.min_component_faces) break;
+        ++small;
+        if (thinner.RemoveComponentIfSafe(comp)) {
+          ++removed;
+          removed_faces += comp.size();
+        }
+      }
+      st.components_removed += removed;
+      st.component_faces_removed += removed_faces;
+      st.small_components_left = small - removed;
+      if (small > 0)
+        monitor.Info("round " + std::to_string(st.rounds) + ": " + Count(small, "components under ") +
+                     std::to_string(options.min_component_faces) + " faces, " + Count(removed, "removed (") +
+                     Count(removed_faces, "faces)"));
+      if (removed == 0) break;
+      changed = true;
+    }
+    if (!changed) break;
+  }
+  st.tetrahedra_left = thinner.Tetrahedra().size();
+  if (st.tetrahedra_left > 0)
+    monitor.Warn(Count(st.tetrahedra_left, "closed tetrahedra are left: none of their face pairs shares a manifold edge"));
+  if (st.small_components_left > 0)
+    monitor.Warn(Count(st.small_components_left, "small components are left: removing them would open a hole"));
+  thinner.OrientComponents();
+
+  TriangleMesh out;
+  out.vertices = thick.vertices;
+  for (size_t f = 0; f < thinner.faces().size(); ++f)
+    if (thinner.alive()[f]) out.faces.push_back(thinner.faces()[f]);
+  out = RemoveUnreferencedVertices(out);
+  monitor.Info(Count(out.vertices.size(), "vertices, ") + Count(out.faces.size(), "faces out"));
+  if (stats_out) *stats_out = st;
+  return out;
+}
+
+EdgeSet NonManifoldEdges(const TriangleMesh& mesh) {
+  const EdgeFaces ef = BuildEdgeFaces(mesh.faces);
+  EdgeSet out;
+  std::unordered_map<int, int> remap;
+  auto vertex = [&](int v) {
+    const auto [it, fresh] = remap.emplace(v, static_cast<int>(out.vertices.size()));
+    if (fresh) out.vertices.push_back(mesh.vertices[static_cast<size_t>(v)]);
+    return it->second;
+  };
+  for (size_t e = 0; e < ef.edges.size(); ++e)
+    if (ef.faces[e].size() >= 3) {
+      const int a = vertex(ef.edges[e][0]);
+      out.edges.push_back({a, vertex(ef.edges[e][1])});
+    }
+  return out;
+}
+
+}  // namespace voroudf

@@ -1,0 +1,64 @@
+#pragma once
+// Stage 4 (DESIGN.md; paper Sec. 3.4, "Mesh Thinning", Fig. 8): collapses the flat volumes of the thick dual
+// mesh by removing face pairs from closed tetrahedra, then removes small components, keeping the edges that
+// are shared by 3+ faces where the surface really branches.
+#include <cstddef>
+
+#include "common/monitor.h"
+#include "common/types.h"
+#include "common/udf.h"
+#include "formats/mesh_io.h"
+
+namespace voroudf {
+
+struct ThinMeshOptions {
+  /// Components with fewer faces than this are removed (--min-component-faces; paper: 10).
+  size_t min_component_faces = 10;
+  /// A face is degenerate when it repeats a vertex or its area is at most this times the squared domain
+  /// diagonal (--degenerate-area-rel); coincident seeds give such faces.
+  double degenerate_area_rel = 1e-14;
+
+  /// Throws UsageError for values that cannot work.
+  void Check() const;
+};
+
+/// What ThinMesh did, for logs and tests.
+struct ThinMeshStats {
+  size_t duplicate_faces = 0;       ///< faces over the same vertex set as an earlier face, dropped
+  size_t degenerate_faces = 0;      ///< dropped
+  size_t tetrahedra = 0;            ///< closed tetrahedra found (over all rounds)
+  size_t tetrahedra_thinned = 0;    ///< of those, the ones a face pair was removed from
+  size_t tetrahedra_left = 0;       ///< closed tetrahedra at the end (no pair on a manifold edge)
+  size_t components_removed = 0;    ///< small components removed
+  size_t component_faces_removed = 0;
+  size_t small_components_left = 0; ///< small components whose removal would have opened a hole
+  int rounds = 0;                   ///< rounds of (tetrahedra, components) until nothing changed
+};
+
+/// Thins a thick dual mesh (paper Sec. 3.4). Written by hand: no installed library handles triangle sets
+/// with edges of any valence (OpenMesh refuses them, DESIGN.md).
+///
+///  0. Drops degenerate faces and duplicate faces (same vertex set; the first is kept).
+///  1. Closed tetrahedra: 4 vertices whose 4 triangles are all present, processed in increasing order of
+///     their sorted vertex quadruple. From each (whose faces are all still present) the pair of faces that
+///     share an edge of valence exactly 2 (a manifold edge, so removing the pair opens no hole elsewhere)
+///     and whose centroids have the largest sum of UDF values is removed (Fig. 8); a tetrahedron with no
+///     such pair is left. Repeated until a pass removes nothing.
+///  2. Small components: maximal sets of faces connected across manifold edges (valence 2), i.e. a
+///     component ends at boundary and non-manifold edges. A component with < min_component_faces faces is
+///     removed when that leaves every one of its non-manifold border edges with 2+ faces (no new hole);
+///     largest mean centroid UDF first (Fig. 8's rule), repeated until none can go. So isolated small pieces, fins and the sides of residual
+///     polyhedra ("non-manifold polyhedral artifacts", Sec. 3.4) go, while a surface is never cut open.
+///  3. Steps 1–2 repeat until neither changes the mesh; unreferenced vertices are dropped (order kept).
+///
+/// \param udf    the field, for the centroid values; its domain diagonal scales degenerate_area_rel
+/// \param thick  vertices + faces with valid indices (the caller validates them)
+/// \param stats  optional counts
+/// Deterministic (faces keep their input order), independent of the thread count.
+TriangleMesh ThinMesh(const Udf& udf, const TriangleMesh& thick, const ThinMeshOptions& options, Monitor& monitor,
+                      ThinMeshStats* stats = nullptr);
+
+/// The edges shared by 3+ faces, as line segments over the vertices they use (for thin-mesh --nm-edges).
+EdgeSet NonManifoldEdges(const TriangleMesh& mesh);
+
+}  // namespace voroudf

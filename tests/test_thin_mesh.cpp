@@ -1,0 +1,270 @@
+// thin-mesh: the thinning rules on hand-made meshes (paper Sec. 3.4, Fig. 8) and the executable's handling of
+// bad input. The field is shape:disc, whose UDF is |z| near the origin, so a face's centroid UDF is its height.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <set>
+
+#include "common/errors.h"
+#include "common/mesh_topology.h"
+#include "common/shapes.h"
+#include "formats/mesh_io.h"
+#include "formats/seeds_io.h"
+#include "stages/thin-mesh/thin_mesh.h"
+#include "tests/support/test_support.h"
+
+namespace voroudf {
+namespace {
+
+using test::RunProgram;
+using test::TempDir;
+
+std::set<Tri> SortedFaces(const TriangleMesh& mesh) {
+  std::set<Tri> out;
+  for (Tri t : mesh.faces) {
+    std::sort(t.begin(), t.end());
+    out.insert(t);
+  }
+  return out;
+}
+
+ThinMeshOptions MinFaces(size_t n) {
+  ThinMeshOptions o;
+  o.min_component_faces = n;
+  return o;
+}
+
+/// A flat tetrahedron over a, b, c, d at heights za..zd above the disc (Fig. 8).
+TriangleMesh Tetrahedron(double za, double zb, double zc, double zd) {
+  TriangleMesh m;
+  m.vertices = {{-0.2, 0.0, za}, {0.2, 0.0, zb}, {0.0, -0.2, zc}, {0.0, 0.2, zd}};
+  m.faces = {{0, 1, 2}, {0, 1, 3}, {0, 2, 3}, {1, 2, 3}};
+  return m;
+}
+
+TEST(ThinMesh, FlatTetrahedronLosesThePairWithTheHighestCentroidUdf) {
+  const auto udf = MakeShape("disc");
+  // c and d are lifted: faces acd and bcd (sharing cd) have the highest centroids and go; abc and abd stay.
+  const TriangleMesh tet = Tetrahedron(0.0, 0.0, 0.01, 0.01);
+  ThinMeshStats stats;
+  const TriangleMesh out = ThinMesh(*udf, tet, MinFaces(1), Monitor::Null(), &stats);
+  ASSERT_EQ(out.faces.size(), 2u);
+  EXPECT_EQ(out.vertices.size(), 4u);
+  const std::set<Tri> faces = SortedFaces(out);
+  EXPECT_TRUE(faces.count({0, 1, 2}) && faces.count({0, 1, 3}));
+  EXPECT_EQ(stats.tetrahedra, 1u);
+  EXPECT_EQ(stats.tetrahedra_thinned, 1u);
+  EXPECT_EQ(stats.tetrahedra_left, 0u);
+
+  // The other way round: a and b lifted, so abc and abd (sharing ab) go.
+  const TriangleMesh out2 = ThinMesh(*udf, Tetrahedron(0.01, 0.01, 0.0, 0.0), MinFaces(1),
+                                     Monitor::Null());
+  const std::set<Tri> faces2 = SortedFaces(out2);
+  ASSERT_EQ(faces2.size(), 2u);
+  EXPECT_TRUE(faces2.count({0, 2, 3}) && faces2.count({1, 2, 3}));
+}
+
+TEST(ThinMesh, OnlyAPairOnAManifoldEdgeGoesWhenTheTetrahedronSitsInASurface) {
+  const auto udf = MakeShape("disc");
+  // Heights make abc + acd (sharing the outer edge ac) the highest pair. Alone, that pair goes.
+  TriangleMesh tet = Tetrahedron(0.03, 0.0, 0.01, 0.0);
+  const std::set<Tri> alone = SortedFaces(ThinMesh(*udf, tet, MinFaces(1), Monitor::Null()));
+  EXPECT_EQ(alone, (std::set<Tri>{{0, 1, 3}, {1, 2, 3}}));
+  // Inside a surface: a fan of faces around the quad a-c-b-d makes every outer edge non-manifold, so only the
+  // pairs on the diagonals ab or cd may go; of those abc + abd has the higher UDF.
+  TriangleMesh surface = tet;
+  const int e = 4;
+  surface.vertices.push_back({-0.3, -0.3, 0.0});  // 4
+  surface.vertices.push_back({0.3, -0.3, 0.0});   // 5
+  surface.vertices.push_back({0.3, 0.3, 0.0});    // 6
+  surface.vertices.push_back({-0.3, 0.3, 0.0});   // 7
+  // Outer ring: faces on ac, cb, bd, da plus faces closing the ring.
+  surface.faces.insert(surface.faces.end(), {{0, 2, e}, {2, 1, e + 1}, {1, 3, e + 2}, {3, 0, e + 3},
+                                              {2, e, e + 1}, {1, e + 1, e + 2}, {3, e + 2, e + 3}, {0, e + 3, e}});
+  ThinMeshStats stats;
+  const TriangleMesh out = ThinMesh(*udf, surface, MinFaces(1), Monitor::Null(), &stats);
+  const std::set<Tri> faces = SortedFaces(out);
+  EXPECT_EQ(faces.size(), 10u);
+  EXPECT_TRUE(faces.count({0, 2, 3}) && faces.count({1, 2, 3})) << "the pair on ab must go, not the one on ac";
+  // The result is a disc: every edge manifold or boundary, Euler characteristic 1.
+  const TopologyStats topo = ComputeTopology(out);
+  EXPECT_EQ(topo.nonmanifold_edges, 0u);
+  EXPECT_EQ(topo.euler, 1);
+  EXPECT_EQ(topo.components, 1u);
+}
+
+/// A strip of `n` triangles along x at offset y0 (an isolated component of n faces).
+void AddStrip(TriangleMesh& m, int n, double y0) {
+  const int base = static_cast<int>(m.vertices.size());
+  for (int k = 0; k < n / 2 + 2; ++k) {
+    m.vertices.push_back({-0.4 + 0.05 * k, y0, 0.0});
+    m.vertices.push_back({-0.4 + 0.05 * k, y0 + 0.05, 0.0});
+  }
+  for (int f = 0; f < n; ++f) {
+    const int k = f / 2;
+    if (f % 2 == 0) m.faces.push_back({base + 2 * k, base + 2 * k + 2, base + 2 * k + 1});
+    else m.faces.push_back({base + 2 * k + 1, base + 2 * k + 2, base + 2 * k + 3});
+  }
+}
+
+/// A flat nx x ny grid of cells of size 0.1 from (-0.3, -0.3), two faces per cell (diagonal 00-11).
+/// Vertex (i, j) is j * (nx + 1) + i.
+void AddGrid(TriangleMesh& m, int nx, int ny) {
+  const int base = static_cast<int>(m.vertices.size());
+  for (int j = 0; j <= ny; ++j)
+    for (int i = 0; i <= nx; ++i) m.vertices.push_back({-0.3 + 0.1 * i, -0.3 + 0.1 * j, 0.0});
+  auto v = [&](int i, int j) { return base + j * (nx + 1) + i; };
+  for (int j = 0; j < ny; ++j)
+    for (int i = 0; i < nx; ++i) {
+      m.faces.push_back({v(i, j), v(i + 1, j), v(i + 1, j + 1)});
+      m.faces.push_back({v(i, j), v(i + 1, j + 1), v(i, j + 1)});
+    }
+}
+
+int AddVertex(TriangleMesh& m, const Vec3& p) {
+  m.vertices.push_back(p);
+  return static_cast<int>(m.vertices.size()) - 1;
+}
+
+TEST(ThinMesh, AComponentOfNineFacesGoesOneOfTenStays) {
+  const auto udf = MakeShape("disc");
+  TriangleMesh m;
+  AddStrip(m, 9, -0.2);
+  AddStrip(m, 10, 0.2);
+  ThinMeshStats stats;
+  const TriangleMesh out = ThinMesh(*udf, m, ThinMeshOptions{}, Monitor::Null(), &stats);
+  EXPECT_EQ(out.faces.size(), 10u);
+  for (const Vec3& v : out.vertices) EXPECT_GT(v.y(), 0.1) << "only the 10-face strip is left";
+  EXPECT_EQ(stats.components_removed, 1u);
+  EXPECT_EQ(stats.component_faces_removed, 9u);
+  // The threshold is an option: with 11, both go.
+  EXPECT_TRUE(ThinMesh(*udf, m, MinFaces(11), Monitor::Null()).faces.empty());
+}
+
+TEST(ThinMesh, AFinOnASurfaceGoesButNoHoleIsOpened) {
+  const auto udf = MakeShape("disc");
+  TriangleMesh m;
+  AddGrid(m, 6, 6);
+  // A fin: one triangle standing on the diagonal of cell (2, 2), vertices 16 and 24, making it non-manifold.
+  m.faces.push_back({16, 24, AddVertex(m, {-0.05, -0.05, 0.05})});
+  const TriangleMesh out = ThinMesh(*udf, m, ThinMeshOptions{}, Monitor::Null());
+  EXPECT_EQ(out.faces.size(), 72u);
+  const TopologyStats topo = ComputeTopology(out);
+  EXPECT_EQ(topo.nonmanifold_edges, 0u);
+  EXPECT_EQ(topo.euler, 1);
+
+  // A residual bubble: a pyramid over cell (2, 2) makes its 4 border edges non-manifold, so its 2 faces and
+  // the pyramid's 4 are two small components over the same loop. Removing both would open a hole; the
+  // pyramid (higher UDF) goes, the cell's faces stay.
+  TriangleMesh p;
+  AddGrid(p, 6, 6);
+  const int apex = AddVertex(p, {-0.05, -0.05, 0.02});
+  for (const auto& [a, b] : std::vector<std::pair<int, int>>{{16, 17}, {17, 24}, {24, 23}, {23, 16}})
+    p.faces.push_back({a, b, apex});
+  ThinMeshStats stats;
+  const TriangleMesh out2 = ThinMesh(*udf, p, ThinMeshOptions{}, Monitor::Null(), &stats);
+  const TopologyStats t2 = ComputeTopology(out2);
+  EXPECT_EQ(out2.faces.size(), 72u);
+  EXPECT_EQ(t2.nonmanifold_edges, 0u);
+  EXPECT_EQ(t2.boundary_edges, 24u);
+  EXPECT_EQ(t2.euler, 1);
+  EXPECT_EQ(stats.components_removed, 1u);
+  for (const Vec3& v : out2.vertices) EXPECT_EQ(v.z(), 0.0) << "the pyramid is the side removed";
+}
+
+TEST(ThinMesh, DuplicateAndDegenerateFacesNeverSurvive) {
+  const auto udf = MakeShape("disc");
+  TriangleMesh m;
+  AddGrid(m, 6, 6);
+  m.faces.push_back({8, 0, 1});                 // same vertex set as face 0, other order
+  m.faces.push_back({3, 3, 4});                 // repeated vertex
+  m.vertices.push_back(m.vertices[5]);          // a coincident copy: zero area
+  m.faces.push_back({5, static_cast<int>(m.vertices.size()) - 1, 6});
+  ThinMeshStats stats;
+  const TriangleMesh out = ThinMesh(*udf, m, ThinMeshOptions{}, Monitor::Null(), &stats);
+  EXPECT_EQ(stats.duplicate_faces, 1u);
+  EXPECT_EQ(stats.degenerate_faces, 2u);
+  EXPECT_EQ(out.faces.size(), 72u);
+  EXPECT_EQ(SortedFaces(out).size(), out.faces.size());
+  for (const Tri& t : out.faces) EXPECT_GT(TriangleQuality(out.vertices[t[0]], out.vertices[t[1]], out.vertices[t[2]]), 0.0);
+}
+
+TEST(ThinMesh, ManifoldComponentsAreOrientedConsistently) {
+  const auto udf = MakeShape("disc");
+  TriangleMesh m;
+  AddGrid(m, 6, 6);
+  std::swap(m.faces[3][0], m.faces[3][1]);
+  std::swap(m.faces[8][1], m.faces[8][2]);
+  const TriangleMesh out = ThinMesh(*udf, m, ThinMeshOptions{}, Monitor::Null());
+  // Consistent orientation: every interior edge is used once in each direction.
+  std::set<std::pair<int, int>> directed;
+  for (const Tri& t : out.faces)
+    for (int k = 0; k < 3; ++k) EXPECT_TRUE(directed.insert({t[k], t[(k + 1) % 3]}).second) << "edge used twice the same way";
+}
+
+TEST(ThinMesh, NonManifoldEdgesAreExtracted) {
+  // Three triangles on one edge (a book with three pages) and one lone triangle.
+  TriangleMesh m;
+  m.vertices = {{0, 0, 0}, {1, 0, 0}, {0.5, 1, 0}, {0.5, -1, 0}, {0.5, 0, 1}, {3, 3, 3}, {4, 3, 3}, {3, 4, 3}};
+  m.faces = {{0, 1, 2}, {0, 1, 3}, {1, 0, 4}, {5, 6, 7}};
+  const EdgeSet nm = NonManifoldEdges(m);
+  ASSERT_EQ(nm.edges.size(), 1u);
+  ASSERT_EQ(nm.vertices.size(), 2u);
+  EXPECT_EQ(nm.vertices[0], m.vertices[0]);
+  EXPECT_EQ(nm.vertices[1], m.vertices[1]);
+}
+
+TEST(ThinMesh, BadOptionsAreUsageErrors) {
+  ThinMeshOptions o;
+  o.degenerate_area_rel = -1;
+  EXPECT_THROW(o.Check(), UsageError);
+}
+
+class ThinMeshExe : public ::testing::Test {
+ protected:
+  TempDir dir_;
+};
+
+TEST_F(ThinMeshExe, WritesMeshAndNonManifoldEdges) {
+  TriangleMesh m;
+  AddGrid(m, 6, 6);
+  m.faces.push_back({16, 24, AddVertex(m, {-0.05, -0.05, 0.05})});  // a fin, kept with --min-component-faces 1
+  WriteMeshPly(dir_ / "thick.ply", m, Provenance{"test", "", ""});
+  const auto r = RunProgram("thin-mesh", {"--udf", "shape:disc", "-i", dir_ / "thick.ply", "-o", dir_ / "mesh.ply",
+                                          "--nm-edges", dir_ / "nm.ply", "--min-component-faces", "1"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(r.out.empty());
+  const TriangleMesh out = ReadMeshPly(dir_ / "mesh.ply");
+  EXPECT_EQ(out.faces.size(), 73u);
+  const std::string nm = test::ReadBytes(dir_ / "nm.ply");
+  EXPECT_NE(nm.find("comment voroudf edges 1"), std::string::npos);
+  EXPECT_NE(nm.find("element edge 1"), std::string::npos);
+}
+
+TEST_F(ThinMeshExe, BadInputExitsThreeAndWritesNothing) {
+  // An index out of range.
+  test::WriteBytes(dir_ / "bad.ply",
+                   "ply\nformat ascii 1.0\ncomment voroudf mesh 1\nelement vertex 3\nproperty float x\nproperty float y\n"
+                   "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n"
+                   "0 0 0\n1 0 0\n0 1 0\n3 0 1 7\n");
+  auto r = RunProgram("thin-mesh", {"--udf", "shape:disc", "-i", dir_ / "bad.ply", "-o", dir_ / "out.ply"});
+  EXPECT_EQ(r.exit_code, 3) << r.err;
+  EXPECT_FALSE(test::Exists(dir_ / "out.ply"));
+  // A seeds file given as the thick mesh.
+  SeedCloud seeds;
+  seeds.Resize(3);
+  seeds.position = {{0, 0, 0}, {0.1, 0, 0}, {0, 0.1, 0}};
+  WriteSeeds(dir_ / "seeds.ply", seeds, Provenance{"test", "", ""});
+  r = RunProgram("thin-mesh", {"--udf", "shape:disc", "-i", dir_ / "seeds.ply", "-o", dir_ / "out.ply"});
+  EXPECT_EQ(r.exit_code, 3) << r.err;
+  EXPECT_NE(r.err.find("thin-mesh: error:"), std::string::npos);
+  EXPECT_FALSE(test::Exists(dir_ / "out.ply"));
+  // A bad option value.
+  r = RunProgram("thin-mesh", {"--udf", "shape:disc", "-i", dir_ / "seeds.ply", "-o", dir_ / "out.ply",
+                               "--degenerate-area-rel", "-1"});
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_EQ(dir_.List().size(), 2u) << "only bad.ply and seeds.ply";
+}
+
+}  // namespace
+}  // namespace voroudf
