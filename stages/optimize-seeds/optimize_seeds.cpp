@@ -1,0 +1,396 @@
+#include "stages/optimize-seeds/optimize_seeds.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <numeric>
+
+#include "common/errors.h"
+#include "common/projection.h"
+#include "stages/optimize-seeds/l1_tangent.h"
+#include "stages/optimize-seeds/repulsion.h"
+#include "stages/optimize-seeds/seed_index.h"
+#include "stages/optimize-seeds/voronoi_cells.h"
+
+namespace voroudf {
+
+void OptimizeSeedsOptions::Check() const {
+  if (samples_per_cell < 3 || samples_per_cell > 100000) throw UsageError("--samples-per-cell must be in [3, 100000]");
+  if (!(gamma > 0.0) || !std::isfinite(gamma)) throw UsageError("--gamma must be positive");
+  if (!(delta > 0.0 && delta < 1.0)) throw UsageError("--delta must be in (0, 1)");
+  if (max_outer_iters < 0) throw UsageError("--max-outer-iters must be at least 0");
+  if (max_inner_iters < 1) throw UsageError("--max-inner-iters must be at least 1");
+  if (lbfgs_max_iters < 1) throw UsageError("--lbfgs-max-iters must be at least 1");
+  if (!(rank_threshold > 0.0 && rank_threshold < 1.0)) throw UsageError("--rank-threshold must be in (0, 1)");
+  if (cell_knn < 1 || cell_knn > 64) throw UsageError("--cell-knn must be in [1, 64]");
+  if (!(cell_radius_factor > 0.0 && cell_radius_factor <= 10.0)) throw UsageError("--cell-radius-factor must be in (0, 10]");
+  if (!(max_step >= 0.0 && max_step <= 100.0)) throw UsageError("--max-step must be in [0, 100]");
+  if (!(repulsion_cutoff >= 1.0 && repulsion_cutoff <= 10.0)) throw UsageError("--repulsion-cutoff must be in [1, 10]");
+  if (!(l1_tol_rel > 0.0 && l1_tol_rel < 0.1)) throw UsageError("--l1-tol-rel must be in (0, 0.1)");
+  if (l1_max_sweeps < 1) throw UsageError("--l1-max-sweeps must be at least 1");
+  if (!(move_tol_rel >= 0.0 && move_tol_rel < 0.1)) throw UsageError("--move-tol-rel must be in [0, 0.1)");
+  if (!(proj_tol_rel > 0.0 && proj_tol_rel < 0.1)) throw UsageError("--proj-tol-rel must be in (0, 0.1)");
+  if (proj_max_iters < 1) throw UsageError("--proj-max-iters must be at least 1");
+}
+
+namespace {
+
+std::string Format(const char* format, double a = 0, double b = 0, double c = 0, double d = 0, double e = 0) {
+  char line[256];
+  std::snprintf(line, sizeof line, format, a, b, c, d, e);
+  return line;
+}
+
+// The state carried through Alg. 1: positions on the zero set with their field, ranks and move spaces.
+struct State {
+  std::vector<Vec3> position;
+  std::vector<double> udf;
+  std::vector<Vec3> normal;
+  std::vector<TangentRank> rank;
+  std::vector<MoveSpace> space;
+};
+
+class Optimizer {
+ public:
+  Optimizer(const Udf& udf, const OptimizeSeedsOptions& options, Monitor& monitor)
+      : udf_(udf), options_(options), monitor_(monitor), diagonal_(udf.Domain().Diagonal()) {
+    cell_options_.samples_per_cell = options.samples_per_cell;
+    cell_options_.radius_knn = options.cell_knn;
+    cell_options_.radius_factor = options.cell_radius_factor;
+    projection_.tolerance = options.proj_tol_rel * diagonal_;
+    projection_.max_iterations = options.proj_max_iters;
+  }
+
+  // Projects `moved` onto the zero set; a seed whose projection fails goes back to `previous` (which is on
+  // the surface). So does a seed that lands within `min_separation` of another seed (both, if both moved):
+  // projection is not injective (everything beyond a cube corner lands on the corner), and two seeds
+  // that meet would make σ, the minimum pairwise distance, collapse for every seed. Returns the largest
+  // displacement from `previous`.
+  double Project(State& s, const std::vector<Vec3>& previous, std::vector<Vec3> moved, double min_separation) {
+    const size_t n = moved.size();
+    ProjectionResult r = ProjectToZeroSet(udf_, moved, projection_, Monitor::Null());
+    std::vector<char> accept(r.converged);
+    const size_t failed = n - r.num_converged;
+    const double floor = std::max(min_separation, 1e-9 * diagonal_);
+    size_t separated = 0;
+    for (int pass = 0; pass < 64; ++pass) {
+      std::vector<Vec3> trial(n);
+      for (size_t i = 0; i < n; ++i) trial[i] = accept[i] ? moved[i] : previous[i];
+      const SeedIndex index(trial);
+      std::vector<char> reject(n, 0);
+#pragma omp parallel
+      {
+        std::vector<int> found;
+#pragma omp for schedule(static)
+        for (long li = 0; li < static_cast<long>(n); ++li) {
+          const size_t i = static_cast<size_t>(li);
+          if (!accept[i] || moved[i] == previous[i]) continue;
+          index.WithinRadius(trial[i], floor * (1.0 + 1e-5) + 1e-12, found);
+          for (int j : found)
+            if (static_cast<size_t>(j) != i && (trial[static_cast<size_t>(j)] - trial[i]).norm() < floor) reject[i] = 1;
+        }
+      }
+      const size_t rejected = static_cast<size_t>(std::count(reject.begin(), reject.end(), 1));
+      if (rejected == 0) break;
+      separated += rejected;
+      for (size_t i = 0; i < n; ++i)
+        if (reject[i]) accept[i] = 0;
+    }
+    double largest = 0.0;
+    for (size_t i = 0; i < n; ++i) {
+      if (accept[i]) {
+        s.position[i] = moved[i];
+        s.udf[i] = r.distance[i];
+        s.normal[i] = r.gradient[i];
+        largest = std::max(largest, (moved[i] - previous[i]).norm());
+      } else {
+        s.position[i] = previous[i];
+      }
+    }
+    if (failed > 0) monitor_.Debug(std::to_string(failed) + " moves undone: projection did not converge");
+    if (separated > 0) monitor_.Debug(std::to_string(separated) + " moves undone: they ended too near another seed");
+    return largest;
+  }
+
+  // Cells, samples, rank and null space of every seed at the current positions.
+  CellSamples Analyze(State& s) {
+    const SeedIndex index(s.position);
+    CellSamples cells = SampleVoronoiCells(udf_, s.position, index, cell_options_, options_.seed, round_++);
+    const long n = static_cast<long>(s.position.size());
+#pragma omp parallel for schedule(static)
+    for (long i = 0; i < n; ++i) {
+      const size_t begin = cells.sample_offset[i], end = cells.sample_offset[i + 1];
+      TangentRank r = ComputeTangentRank(cells.gradient.data() + begin, end - begin, options_.rank_threshold);
+      MoveSpace& space = s.space[i];
+      if (r.rank == 0) {
+        // No usable sample (an empty cell within the budget): move in the tangent plane of the seed's own
+        // gradient, as on a sheet, and report rank 0 ("unknown").
+        const TangentRank own = ComputeTangentRank(&s.normal[i], 1, options_.rank_threshold);
+        space.dim = own.rank == 1 ? 2 : 0;
+        space.basis.setZero();
+        space.basis.leftCols<2>() = own.v.rightCols<2>();
+      } else {
+        space.dim = 3 - r.rank;
+        space.basis.setZero();
+        for (int d = 0; d < space.dim; ++d) space.basis.col(d) = r.v.col(r.rank + d);
+      }
+      s.rank[i] = r;
+    }
+    last_short_cells_ = cells.short_cells;
+    last_acceptance_ = cells.draws ? static_cast<double>(cells.point.size()) / static_cast<double>(cells.draws) : 0.0;
+    return cells;
+  }
+
+  // Paper Eq. (energy_l1_regularizer) for every seed, inside its cell. Returns the new (unprojected) positions.
+  std::vector<Vec3> L1Step(const State& s, const CellSamples& cells) {
+    const long n = static_cast<long>(s.position.size());
+    const double inv_l = 1.0 / diagonal_;
+    L1TangentOptions solver;
+    solver.gap_tolerance = options_.gamma * options_.l1_tol_rel * options_.l1_tol_rel;
+    solver.max_sweeps = options_.l1_max_sweeps;
+    std::vector<Vec3> moved(s.position);
+    std::vector<int> sweeps(static_cast<size_t>(n), 0);
+    std::vector<char> converged(static_cast<size_t>(n), 1);
+#pragma omp parallel
+    {
+      L1TangentProblem problem;
+      problem.gamma = options_.gamma;
+#pragma omp for schedule(dynamic, 32)
+      for (long i = 0; i < n; ++i) {
+        const Vec3& x0 = s.position[i];
+        problem.Clear();
+        for (size_t m = cells.sample_offset[i]; m < cells.sample_offset[i + 1]; ++m) {
+          const Vec3& g = cells.gradient[m];
+          if (g.squaredNorm() < 0.25) continue;  // a source that cannot tell: no tangent plane
+          const Vec3 a = g.normalized();
+          problem.a.push_back(a);
+          problem.b.push_back((a.dot(cells.point[m] - x0) - cells.distance[m]) * inv_l);
+        }
+        if (problem.a.empty()) continue;
+        for (size_t k = cells.neighbour_offset[i]; k < cells.neighbour_offset[i + 1]; ++k) {
+          const Vec3 e = s.position[static_cast<size_t>(cells.neighbour[k])] - x0;
+          const double len = e.norm();
+          problem.c.push_back(e / len);
+          problem.h.push_back(0.5 * len * inv_l);  // the bisector plane of x_i and x_j
+        }
+        // The cell is also bounded by the cube circumscribing its sampling ball: the tangent planes are only
+        // trusted where they were sampled (docs/optimize-seeds.md, "Bounding the cells").
+        for (int axis = 0; axis < 3; ++axis) {
+          for (double sign : {1.0, -1.0}) {
+            problem.c.push_back(sign * Vec3::Unit(axis));
+            problem.h.push_back(cells.radius[i] * inv_l);
+          }
+        }
+        const L1TangentSolution solution = SolveL1Tangent(problem, solver);
+        moved[i] = x0 + diagonal_ * solution.y;
+        sweeps[i] = solution.sweeps;
+        converged[i] = solution.converged;
+      }
+    }
+    const size_t failed = std::count(converged.begin(), converged.end(), 0);
+    const double mean_sweeps = std::accumulate(sweeps.begin(), sweeps.end(), 0.0) / static_cast<double>(n);
+    monitor_.Debug(Format("L1 step: %.1f dual sweeps per seed on average", mean_sweeps));
+    if (failed > 0)
+      monitor_.Debug(std::to_string(failed) + " L1 steps hit --l1-max-sweeps before the gap certificate "
+                     "(their feasible best point is used)");
+    return moved;
+  }
+
+  double MinimumSpacing(const std::vector<Vec3>& positions) const {
+    const SeedIndex index(positions);
+    const long n = static_cast<long>(positions.size());
+    std::vector<double> nearest(static_cast<size_t>(n), INFINITY);
+#pragma omp parallel
+    {
+      std::vector<int> knn;
+#pragma omp for schedule(static)
+      for (long i = 0; i < n; ++i) {
+        index.Nearest(positions[i], 2, knn);
+        for (int j : knn)
+          if (j != i) nearest[i] = std::min(nearest[i], (positions[static_cast<size_t>(j)] - positions[i]).norm());
+      }
+    }
+    return *std::min_element(nearest.begin(), nearest.end());
+  }
+
+  NeighbourLists RepulsionNeighbours(const std::vector<Vec3>& positions, double radius) const {
+    const SeedIndex index(positions);
+    const long n = static_cast<long>(positions.size());
+    std::vector<std::vector<std::pair<int, int>>> per_seed(static_cast<size_t>(n));
+#pragma omp parallel
+    {
+      std::vector<int> found;
+#pragma omp for schedule(dynamic, 64)
+      for (long i = 0; i < n; ++i) {
+        index.WithinRadius(positions[i], radius, found);
+        for (int j : found)
+          if (j > i) per_seed[i].emplace_back(static_cast<int>(i), j);
+      }
+    }
+    std::vector<std::pair<int, int>> pairs;
+    for (auto& p : per_seed) pairs.insert(pairs.end(), p.begin(), p.end());
+    return NeighbourLists::FromPairs(static_cast<size_t>(n), std::move(pairs));
+  }
+
+  double diagonal() const { return diagonal_; }
+  size_t last_short_cells() const { return last_short_cells_; }
+  double last_acceptance() const { return last_acceptance_; }
+
+ private:
+  const Udf& udf_;
+  const OptimizeSeedsOptions& options_;
+  Monitor& monitor_;
+  double diagonal_;
+  CellSamplingOptions cell_options_;
+  ProjectionOptions projection_;
+  uint64_t round_ = 0;  // sampling rounds so far: the random stream of every round differs
+  size_t last_short_cells_ = 0;
+  double last_acceptance_ = 0.0;
+};
+
+SeedCloud ToCloud(const State& s) {
+  SeedCloud cloud;
+  cloud.Resize(s.position.size());
+  for (size_t i = 0; i < s.position.size(); ++i) {
+    cloud.position[i] = s.position[i];
+    cloud.normal[i] = s.normal[i];
+    cloud.udf[i] = s.udf[i];
+    cloud.rank[i] = static_cast<uint8_t>(s.rank[i].rank);
+  }
+  return cloud;
+}
+
+void CountRanks(const State& s, OuterIterationReport& report) {
+  double sum = 0.0;
+  for (size_t i = 0; i < s.position.size(); ++i) {
+    ++report.rank_count[std::clamp(s.rank[i].rank, 0, 3)];
+    sum += std::abs(s.udf[i]);
+  }
+  report.mean_abs_udf = sum / static_cast<double>(s.position.size());
+}
+
+// Input seeds on the zero set, in input order, without exact duplicates (their repulsion has no direction).
+State Prepare(const Udf& udf, const SeedCloud& input, const ProjectionOptions& projection, Monitor& monitor) {
+  if (input.size() < 2)
+    throw InputError("input seeds", "has " + std::to_string(input.size()) + " seed(s); optimize-seeds needs at least 2");
+  std::vector<size_t> order(input.size());
+  std::iota(order.begin(), order.end(), 0);
+  auto less = [&](size_t a, size_t b) {
+    const Vec3 &p = input.position[a], &q = input.position[b];
+    return std::tie(p.x(), p.y(), p.z(), a) < std::tie(q.x(), q.y(), q.z(), b);
+  };
+  std::sort(order.begin(), order.end(), less);
+  std::vector<char> keep(input.size(), 1);
+  for (size_t k = 1; k < order.size(); ++k)
+    if (input.position[order[k]] == input.position[order[k - 1]]) keep[order[k]] = 0;
+  std::vector<Vec3> points;
+  for (size_t i = 0; i < input.size(); ++i)
+    if (keep[i]) points.push_back(input.position[i]);
+  if (points.size() < input.size())
+    monitor.Warn(std::to_string(input.size() - points.size()) + " duplicate seeds dropped");
+  if (points.size() < 2) throw InputError("input seeds", "fewer than 2 distinct seeds");
+
+  ProjectionResult r = ProjectToZeroSet(udf, points, projection, monitor);
+  State s;
+  for (size_t i = 0; i < points.size(); ++i) {
+    if (!r.converged[i]) continue;
+    s.position.push_back(points[i]);
+    s.udf.push_back(r.distance[i]);
+    s.normal.push_back(r.gradient[i]);
+  }
+  if (s.position.size() < points.size())
+    monitor.Warn(std::to_string(points.size() - s.position.size()) + " seeds dropped: projection onto the zero set did not converge");
+  if (s.position.size() < 2) throw NumericalError("fewer than 2 seeds reached the surface of " + udf.Describe());
+  s.rank.resize(s.position.size());
+  s.space.resize(s.position.size());
+  return s;
+}
+
+}  // namespace
+
+SeedCloud OptimizeSeeds(const Udf& udf, const SeedCloud& input, const OptimizeSeedsOptions& options, Monitor& monitor,
+                        const std::function<void(const OuterIterationReport&, const SeedCloud&)>& on_iteration) {
+  options.Check();
+  using Clock = std::chrono::steady_clock;
+  const auto start = Clock::now();
+  Optimizer opt(udf, options, monitor);
+  ProjectionOptions projection;
+  projection.tolerance = options.proj_tol_rel * opt.diagonal();
+  projection.max_iterations = options.proj_max_iters;
+  State s = Prepare(udf, input, projection, monitor);
+  const size_t n = s.position.size();
+  monitor.Info(std::to_string(n) + " seeds on the surface; domain diagonal " + Format("%.6g", opt.diagonal()));
+
+  RepulsionOptions repulsion;
+  repulsion.max_iterations = options.lbfgs_max_iters;
+  repulsion.max_step = options.max_step;
+  double sigma = 0.0;  // kernel width of the previous outer iteration (0 before the first)
+  for (int outer = 1; outer <= options.max_outer_iters; ++outer) {
+    const auto outer_start = Clock::now();
+    OuterIterationReport report;
+    report.iteration = outer;
+    {
+      Task task(monitor, "outer iteration " + std::to_string(outer), static_cast<uint64_t>(options.max_inner_iters + 1));
+      // Alg. 1 line 3: the L1 tangent step, then back onto the zero set.
+      const CellSamples cells = opt.Analyze(s);
+      const std::vector<Vec3> before = s.position;
+      const double l1_move = opt.Project(s, before, opt.L1Step(s, cells), 0.5 * sigma);
+      task.Advance();
+      // Line 4: the kernel width.
+      report.sigma = sigma = opt.MinimumSpacing(s.position);
+      // Lines 5–15: repulsion rounds.
+      double previous_gradient = -1.0;
+      for (int inner = 1; inner <= options.max_inner_iters; ++inner) {
+        const auto t0 = Clock::now();
+        opt.Analyze(s);
+        const auto t1 = Clock::now();
+        const NeighbourLists neighbours = opt.RepulsionNeighbours(s.position, options.repulsion_cutoff * report.sigma);
+        const RepulsionResult r = MinimizeRepulsion(s.position, s.space, neighbours, report.sigma, repulsion);
+        const auto t2 = Clock::now();
+        const std::vector<Vec3> previous = s.position;
+        report.max_inner_move = std::max(report.max_inner_move, opt.Project(s, previous, r.positions, 0.5 * report.sigma));
+        const auto t3 = Clock::now();
+        monitor.Debug(Format("  times: cells %.3f s, repulsion %.3f s, projection %.3f s",
+                             std::chrono::duration<double>(t1 - t0).count(), std::chrono::duration<double>(t2 - t1).count(),
+                             std::chrono::duration<double>(t3 - t2).count()));
+        report.energy = RepulsionEnergy(s.position, neighbours, report.sigma, nullptr);
+        report.inner_rounds = inner;
+        task.Advance();
+        monitor.Debug(Format("  inner %.0f: energy %.6g -> %.6g, projected gradient %.4g, %.0f L-BFGS iterations",
+                             inner, r.initial_energy, report.energy, r.initial_gradient_norm, r.iterations));
+        const double g = r.initial_gradient_norm;
+        const bool settled = previous_gradient >= 0.0 && std::abs(g - previous_gradient) <= options.delta * previous_gradient;
+        previous_gradient = g;
+        if (g == 0.0 || settled) break;
+      }
+      task.Advance(static_cast<uint64_t>(options.max_inner_iters - report.inner_rounds));
+      monitor.Debug(Format("L1 step moved seeds up to %.3g (relative)", l1_move / opt.diagonal()));
+    }
+    CountRanks(s, report);
+    report.seconds = std::chrono::duration<double>(Clock::now() - outer_start).count();
+    monitor.Info(Format("outer %.0f: sigma %.4g (rel), energy %.6g, mean |udf| %.3g (rel), %.0f inner rounds, ",
+                        outer, report.sigma / opt.diagonal(), report.energy, report.mean_abs_udf / opt.diagonal(),
+                        report.inner_rounds) +
+                 "ranks 0/1/2/3: " + std::to_string(report.rank_count[0]) + "/" + std::to_string(report.rank_count[1]) +
+                 "/" + std::to_string(report.rank_count[2]) + "/" + std::to_string(report.rank_count[3]) +
+                 Format(", cell acceptance %.2f, %.2f s", opt.last_acceptance(), report.seconds));
+    if (on_iteration) on_iteration(report, ToCloud(s));
+    if (report.max_inner_move <= options.move_tol_rel * opt.diagonal()) {
+      monitor.Info("converged: the inner loop made no update");
+      break;
+    }
+  }
+  // Ranks at the final positions, for build-gvd and the viewer.
+  opt.Analyze(s);
+  OuterIterationReport final_report;
+  CountRanks(s, final_report);
+  monitor.Info(Format("done in %.2f s; mean |udf| %.3g (rel); ", std::chrono::duration<double>(Clock::now() - start).count(),
+                      final_report.mean_abs_udf / opt.diagonal()) +
+               "ranks 0/1/2/3: " + std::to_string(final_report.rank_count[0]) + "/" +
+               std::to_string(final_report.rank_count[1]) + "/" + std::to_string(final_report.rank_count[2]) + "/" +
+               std::to_string(final_report.rank_count[3]));
+  return ToCloud(s);
+}
+
+}  // namespace voroudf

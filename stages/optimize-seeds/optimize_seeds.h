@@ -1,0 +1,64 @@
+#pragma once
+// Stage 2 (DESIGN.md; paper Sec. 3.1–3.2, Alg. 1): moves seeds onto the surface's sharp and non-manifold
+// features with the constrained L1 tangent step, and spreads them evenly with feature-aware repulsion.
+#include <cstdint>
+#include <functional>
+
+#include "common/monitor.h"
+#include "common/udf.h"
+#include "formats/seeds_io.h"
+
+namespace voroudf {
+
+struct OptimizeSeedsOptions {
+  uint64_t seed = 0;              ///< RNG seed for the cell samples (--seed)
+  int samples_per_cell = 100;     ///< M, samples per Voronoi cell (paper: 100) (--samples-per-cell)
+  double gamma = 10.0;            ///< γ, proximity weight, lengths relative to the domain diagonal (paper: 10) (--gamma)
+  double delta = 1e-3;            ///< δ, inner loop stops when the gradient changes by less than this, relatively (paper: 1e-3) (--delta)
+  int max_outer_iters = 10;       ///< cap on Alg. 1's outer loop (--max-outer-iters)
+  int max_inner_iters = 10;       ///< cap on Alg. 1's inner loop (--max-inner-iters)
+  int lbfgs_max_iters = 50;       ///< L-BFGS iterations per inner round (Ceres' default) (--lbfgs-max-iters)
+  double rank_threshold = 0.25;   ///< τ: rank(A) = #{singular values > τ·s_1} (--rank-threshold)
+  int cell_knn = 6;               ///< the cell's bounding ball has radius cell_radius_factor × distance to the k-th nearest seed (--cell-knn)
+  double cell_radius_factor = 0.5;///< (--cell-radius-factor)
+  double max_step = 0.5;          ///< trust region: a repulsion round moves a seed at most this many σ (--max-step)
+  double repulsion_cutoff = 3.0;  ///< neighbours interact within this many σ (kernel 1.1e-2 at 3σ) (--repulsion-cutoff)
+  double l1_tol_rel = 1e-6;       ///< L1 step solved to this position accuracy (relative to the diagonal) (--l1-tol-rel)
+  int l1_max_sweeps = 2000;       ///< dual coordinate-ascent sweeps before the L1 step gives up (--l1-max-sweeps)
+  double move_tol_rel = 1e-6;     ///< an inner loop moving no seed farther than this (relative) "makes no update" (--move-tol-rel)
+  double proj_tol_rel = 1e-5;     ///< projection tolerance on d, relative to the diagonal (as sample-seeds) (--proj-tol-rel)
+  int proj_max_iters = 50;        ///< projection steps before a move is undone (--proj-max-iters)
+
+  /// Throws UsageError for values that cannot work.
+  void Check() const;
+};
+
+/// Summary of one outer iteration, passed to the trace callback and logged.
+struct OuterIterationReport {
+  int iteration = 0;               ///< 1-based
+  double sigma = 0.0;              ///< kernel width (world units)
+  double energy = 0.0;             ///< repulsion energy at the end of the inner loop
+  int inner_rounds = 0;
+  double max_inner_move = 0.0;     ///< largest seed displacement in the inner loop (world units)
+  double mean_abs_udf = 0.0;
+  size_t rank_count[4] = {0, 0, 0, 0};
+  double seconds = 0.0;
+};
+
+/// Paper Alg. 1 lines 2–16. Input seeds are first projected onto the zero set (seeds that do not converge
+/// and exact duplicates are dropped, with a warning). Then, per outer iteration: (1) the constrained L1
+/// tangent step for every seed inside its Voronoi cell (l1_tangent.h); projection; (2) σ = minimum pairwise
+/// seed distance; (3) inner rounds of: cells and samples recomputed, rank and null space V₀ of every seed's
+/// tangent-plane matrix, Gaussian repulsion over neighbours within repulsion_cutoff·σ minimised with L-BFGS
+/// in the null spaces (repulsion.h), projection — until the projected gradient's norm changes by less than δ
+/// relatively or max_inner_iters. The outer loop ends when an inner loop moves no seed farther than
+/// move_tol_rel·diagonal, or after max_outer_iters. Finally ranks are recomputed at the final positions.
+/// Output seeds lie on the zero set (d < proj_tol_rel·diagonal) with their UDF value, gradient and rank.
+/// `on_iteration` (optional) sees the seeds after every outer iteration (for --trace).
+/// Deterministic for given inputs and options, also across thread counts (fixed-order reductions,
+/// per-seed random streams). Throws InputError for fewer than 2 distinct seeds, NumericalError if fewer
+/// than 2 seeds reach the surface.
+SeedCloud OptimizeSeeds(const Udf& udf, const SeedCloud& input, const OptimizeSeedsOptions& options, Monitor& monitor,
+                        const std::function<void(const OuterIterationReport&, const SeedCloud&)>& on_iteration = {});
+
+}  // namespace voroudf

@@ -1,0 +1,43 @@
+#pragma once
+// Samples inside the seeds' Voronoi cells (paper Sec. 3.1: "M points sampled within its Voronoi cell Ω_i"),
+// their UDF values and gradients, and the cells' bounding half-spaces.
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "common/monitor.h"
+#include "common/udf.h"
+#include "stages/optimize-seeds/seed_index.h"
+
+namespace voroudf {
+
+struct CellSamplingOptions {
+  int samples_per_cell = 100;    ///< M
+  int radius_knn = 6;            ///< k: the cell is bounded by a ball of radius factor × (distance to the k-th nearest seed)
+  double radius_factor = 1.5;
+  int max_draws_per_sample = 50; ///< rejection budget: at most M × this draws per cell
+};
+
+/// Per seed i: the bounding radius R_i, the seeds within 2 R_i (the only ones whose bisector planes can cut
+/// the ball B(x_i, R_i): a seed farther than 2R cannot be nearer than x_i to any point of the ball), and the
+/// accepted samples with their UDF value and gradient.
+struct CellSamples {
+  std::vector<double> radius;
+  std::vector<size_t> neighbour_offset;  ///< CSR over seeds, neighbours nearest first, self excluded
+  std::vector<int> neighbour;
+  std::vector<size_t> sample_offset;     ///< samples of seed i: [sample_offset[i], sample_offset[i+1])
+  std::vector<Vec3> point;
+  std::vector<double> distance;
+  std::vector<Vec3> gradient;
+  uint64_t draws = 0;                    ///< candidate points drawn in total (acceptance = point.size() / draws)
+  size_t short_cells = 0;                ///< cells that got fewer than M samples within the budget
+};
+
+/// Draws up to M points uniformly in Ω_i ∩ B(x_i, R_i) for every seed by rejection from the ball (exact
+/// nearest-seed test against the seeds within 2 R_i, found with PCL's kd-tree), then evaluates the UDF at
+/// all of them in one batch. Seed i draws from the counter-based stream (rng_seed, round · N + i), so the
+/// result does not depend on the thread count. \pre seeds.size() ≥ 2, index built over `seeds`.
+CellSamples SampleVoronoiCells(const Udf& udf, const std::vector<Vec3>& seeds, const SeedIndex& index,
+                               const CellSamplingOptions& options, uint64_t rng_seed, uint64_t round);
+
+}  // namespace voroudf
