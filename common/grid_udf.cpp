@@ -12,8 +12,13 @@
 #include "common/errors.h"
 #include "common/udf_spec.h"
 
+#include <Eigen/Eigenvalues>
+
 namespace voroudf {
 namespace {
+
+// Below kNormalBand grid spacings from the zero set the gradient comes from the Hessian of q (see EvaluateChunk).
+constexpr double kNormalBand = 0.25;
 
 std::string ReadAll(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
@@ -56,7 +61,7 @@ std::string HeaderValue(const std::string& header, const std::string& key, const
 // the ghost nodes -1 and n (linear extrapolation: f(-1) = 2 f(0) - f(1)) become weights on real nodes.
 struct Stencil {
   size_t idx[4];
-  double w[4], dw[4];
+  double w[4], dw[4], ddw[4];
 };
 
 Stencil AxisStencil(double u, size_t n) {
@@ -74,22 +79,26 @@ Stencil AxisStencil(double u, size_t n) {
   s.dw[1] = 0.5 * (9 * t2 - 10 * t);
   s.dw[2] = 0.5 * (-9 * t2 + 8 * t + 1);
   s.dw[3] = 0.5 * (3 * t2 - 2 * t);
+  s.ddw[0] = -3 * t + 2;
+  s.ddw[1] = 9 * t - 5;
+  s.ddw[2] = -9 * t + 4;
+  s.ddw[3] = 3 * t - 1;
   s.idx[1] = i0;
   s.idx[2] = i0 + 1;
-  if (i0 == 0) {  // ghost -1 = 2 f(0) - f(1)
-    s.w[1] += 2 * s.w[0], s.w[2] -= s.w[0], s.dw[1] += 2 * s.dw[0], s.dw[2] -= s.dw[0];
-    s.w[0] = s.dw[0] = 0.0;
-    s.idx[0] = i0;
-  } else {
-    s.idx[0] = i0 - 1;
-  }
-  if (i0 + 2 >= n) {  // ghost n = 2 f(n-1) - f(n-2)
-    s.w[2] += 2 * s.w[3], s.w[1] -= s.w[3], s.dw[2] += 2 * s.dw[3], s.dw[1] -= s.dw[3];
-    s.w[3] = s.dw[3] = 0.0;
-    s.idx[3] = i0 + 1;
-  } else {
-    s.idx[3] = i0 + 2;
-  }
+  s.idx[0] = i0 > 0 ? i0 - 1 : i0;
+  s.idx[3] = i0 + 2 < n ? i0 + 2 : i0 + 1;
+  // Ghost nodes -1 and n by quadratic extrapolation, f(-1) = 3 f(0) - 3 f(1) + f(2), which keeps Keys'
+  // third order up to the box faces (the boundary condition of Keys 1981); linear with only 2 samples.
+  auto fold = [&s](int ghost, int e0, int e1, int e2, bool quadratic) {
+    const double c0 = quadratic ? 3.0 : 2.0, c1 = quadratic ? -3.0 : -1.0, c2 = quadratic ? 1.0 : 0.0;
+    double* arrays[3] = {s.w, s.dw, s.ddw};
+    for (double* a : arrays) {
+      a[e0] += c0 * a[ghost], a[e1] += c1 * a[ghost], a[e2] += c2 * a[ghost];
+      a[ghost] = 0.0;
+    }
+  };
+  if (i0 == 0) fold(0, 1, 2, 3, n >= 3);        // entries 1, 2, 3 are nodes 0, 1, 2
+  if (i0 + 2 >= n) fold(3, 2, 1, 0, n >= 3);    // entries 2, 1, 0 are nodes n-1, n-2, n-3
   return s;
 }
 
@@ -288,6 +297,7 @@ std::unique_ptr<GridUdf> GridUdf::Open(const std::string& path, const std::strin
 void GridUdf::EvaluateChunk(const Vec3* points, size_t count, double* distance, Vec3* gradient) const {
   const bool given = !gradient_.empty();
   const double tiny = 1e-14 * box_.Diagonal();
+  const double band = kNormalBand * h_.minCoeff();
   for (size_t n = 0; n < count; ++n) {
     const Vec3& x = points[n];
     if (!x.allFinite()) {
@@ -298,35 +308,57 @@ void GridUdf::EvaluateChunk(const Vec3* points, size_t count, double* distance, 
     const Vec3 p = x.cwiseMax(box_.min).cwiseMin(box_.max);
     Stencil s[3];
     for (int k = 0; k < 3; ++k) s[k] = AxisStencil((p[k] - box_.min[k]) / h_[k], dims_[k]);
+    // One pass over the 4x4x4 samples: q, grad q and the Hessian of q (used only near the zero set).
     double q = 0.0;
     Vec3 dq = Vec3::Zero();
+    double hxx = 0, hyy = 0, hzz = 0, hxy = 0, hxz = 0, hyz = 0;
     Vec3 g_given = Vec3::Zero();
     for (int a = 0; a < 4; ++a) {
       for (int b = 0; b < 4; ++b) {
         const size_t row = (s[0].idx[a] * dims_[1] + s[1].idx[b]) * dims_[2];
-        double f = 0.0, fz = 0.0;
+        double f = 0.0, fz = 0.0, fzz = 0.0;
         Vec3 gz = Vec3::Zero();
         for (int c = 0; c < 4; ++c) {
           const double v = q_[row + s[2].idx[c]];
           f += s[2].w[c] * v;
           fz += s[2].dw[c] * v;
+          fzz += s[2].ddw[c] * v;
           if (given) {
             const float* g = &gradient_[3 * (row + s[2].idx[c])];
             gz += s[2].w[c] * Vec3(g[0], g[1], g[2]);
           }
         }
-        const double wab = s[0].w[a] * s[1].w[b];
-        q += wab * f;
-        dq.x() += s[0].dw[a] * s[1].w[b] * f;
-        dq.y() += s[0].w[a] * s[1].dw[b] * f;
-        dq.z() += wab * fz;
-        if (given) g_given += wab * gz;
+        const double wa = s[0].w[a], wb = s[1].w[b], da = s[0].dw[a], db = s[1].dw[b];
+        q += wa * wb * f;
+        dq.x() += da * wb * f;
+        dq.y() += wa * db * f;
+        dq.z() += wa * wb * fz;
+        hxx += s[0].ddw[a] * wb * f;
+        hyy += wa * s[1].ddw[b] * f;
+        hzz += wa * wb * fzz;
+        hxy += da * db * f;
+        hxz += da * wb * fz;
+        hyz += wa * db * fz;
+        if (given) g_given += wa * wb * gz;
       }
     }
     dq = dq.cwiseQuotient(h_);
     const double d_in = std::sqrt(std::max(q, 0.0));
-    // In-box part of the gradient of d: grad q / 2d, or the given gradient.
+    // In-box part of the gradient of d: grad q / 2d (same direction as grad q), or the given gradient.
     Vec3 g_in = given ? g_given : (d_in > 0.0 ? Vec3(dq / (2.0 * d_in)) : dq);
+    if (!given && d_in < band) {
+      // Near the zero set grad q = 2 d n + (interpolation error) is dominated by the error and vanishes at
+      // the interpolant's minimum; the Hessian of q (about 2 n n^T at a sheet) still knows the normal.
+      Eigen::Matrix3d hess;
+      hess << hxx / (h_.x() * h_.x()), hxy / (h_.x() * h_.y()), hxz / (h_.x() * h_.z()),
+              hxy / (h_.x() * h_.y()), hyy / (h_.y() * h_.y()), hyz / (h_.y() * h_.z()),
+              hxz / (h_.x() * h_.z()), hyz / (h_.y() * h_.z()), hzz / (h_.z() * h_.z());
+      Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig;
+      eig.computeDirect(hess);
+      Vec3 normal = eig.eigenvectors().col(2);
+      if (normal.dot(dq) < 0.0) normal = -normal;
+      if (normal.allFinite() && eig.eigenvalues()(2) > 0.0) g_in = normal;
+    }
     const Vec3 out = x - p;
     const double out_len = out.norm();
     Vec3 g = g_in;
