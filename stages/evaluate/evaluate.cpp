@@ -9,6 +9,7 @@
 #include <cstdlib>
 #include <limits>
 #include <memory>
+#include <utility>
 
 #include "common/errors.h"
 #include "common/rng.h"
@@ -48,10 +49,45 @@ flann::SearchParams ExactSearch() {
   return params;
 }
 
-std::vector<double> QueryRows(const std::vector<Vec3>& points, size_t begin, size_t end) {
+// Spreads the low 21 bits of x to every third bit (Morton code of one axis).
+uint64_t SpreadBits(uint64_t x) {
+  x &= 0x1FFFFF;
+  x = (x | x << 32) & 0x1F00000000FFFFull;
+  x = (x | x << 16) & 0x1F0000FF0000FFull;
+  x = (x | x << 8) & 0x100F00F00F00F00Full;
+  x = (x | x << 4) & 0x10C30C30C30C30C3ull;
+  x = (x | x << 2) & 0x1249249249249249ull;
+  return x;
+}
+
+// Query order along a Z-order curve: consecutive queries visit the same kd-tree cells, which the samples'
+// random face order would not (DESIGN.md measures a 2.5x gain for kNN). Only the order of the work changes,
+// never a result.
+std::vector<size_t> MortonOrder(const std::vector<Vec3>& points) {
+  Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+  for (const Vec3& p : points) {
+    lo = lo.cwiseMin(p);
+    hi = hi.cwiseMax(p);
+  }
+  const double extent = std::max((hi - lo).maxCoeff(), 1e-300);
+  std::vector<std::pair<uint64_t, size_t>> keyed(points.size());
+  for (size_t i = 0; i < points.size(); ++i) {
+    uint64_t code = 0;
+    for (int k = 0; k < 3; ++k)
+      code |= SpreadBits(static_cast<uint64_t>((points[i][k] - lo[k]) / extent * 2097151.0)) << k;
+    keyed[i] = {code, i};
+  }
+  std::sort(keyed.begin(), keyed.end());
+  std::vector<size_t> order(points.size());
+  for (size_t i = 0; i < points.size(); ++i) order[i] = keyed[i].second;
+  return order;
+}
+
+std::vector<double> QueryRows(const std::vector<Vec3>& points, const std::vector<size_t>& order, size_t begin,
+                              size_t end) {
   std::vector<double> q(3 * (end - begin));
   for (size_t i = begin; i < end; ++i)
-    for (int k = 0; k < 3; ++k) q[3 * (i - begin) + k] = points[i][k];
+    for (int k = 0; k < 3; ++k) q[3 * (i - begin) + k] = points[order[i]][k];
   return q;
 }
 
@@ -182,16 +218,17 @@ std::vector<double> NearestDistances(const std::vector<Vec3>& from, const std::v
   if (from.empty()) return distance;
   const KdTree tree(to);
   const flann::SearchParams params = ExactSearch();
+  const std::vector<size_t> order = MortonOrder(from);
   for (size_t begin = 0; begin < from.size(); begin += kQueryBlock) {
     const size_t end = std::min(from.size(), begin + kQueryBlock);
-    std::vector<double> q = QueryRows(from, begin, end);
+    std::vector<double> q = QueryRows(from, order, begin, end);
     std::vector<int> index(end - begin);
     std::vector<double> dist2(end - begin);
     flann::Matrix<double> queries(q.data(), end - begin, 3);
     flann::Matrix<int> indices(index.data(), end - begin, 1);
     flann::Matrix<double> dists(dist2.data(), end - begin, 1);
     tree.index->knnSearch(queries, indices, dists, 1, params);
-    for (size_t i = begin; i < end; ++i) distance[i] = (from[i] - to[index[i - begin]]).norm();
+    for (size_t i = begin; i < end; ++i) distance[order[i]] = (from[order[i]] - to[index[i - begin]]).norm();
     monitor.Advance(end - begin);
   }
   return distance;
@@ -224,9 +261,10 @@ std::vector<Vec3> EdgePoints(const SurfaceSamples& samples, double radius, doubl
   const KdTree tree(samples.points);
   const flann::SearchParams params = ExactSearch();
   std::vector<char> is_edge(n, 0);
+  const std::vector<size_t> order = MortonOrder(samples.points);
   for (size_t begin = 0; begin < n; begin += kQueryBlock) {
     const size_t end = std::min(n, begin + kQueryBlock);
-    std::vector<double> q = QueryRows(samples.points, begin, end);
+    std::vector<double> q = QueryRows(samples.points, order, begin, end);
     std::vector<std::vector<int>> indices;
     std::vector<std::vector<double>> dists;
     // L2_Simple works on squared distances, so is its radius.
@@ -234,10 +272,10 @@ std::vector<Vec3> EdgePoints(const SurfaceSamples& samples, double radius, doubl
                              static_cast<float>(radius * radius), params);
 #pragma omp parallel for schedule(static)
     for (long long i = static_cast<long long>(begin); i < static_cast<long long>(end); ++i) {
-      const Vec3& ni = samples.normals[i];
+      const Vec3& ni = samples.normals[order[i]];
       for (int j : indices[i - begin])
         if (std::abs(ni.dot(samples.normals[j])) < cos_threshold) {
-          is_edge[i] = 1;
+          is_edge[order[i]] = 1;
           break;
         }
     }
