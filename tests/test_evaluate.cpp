@@ -467,6 +467,15 @@ class EvaluateExe : public ::testing::Test {
       obj += "f " + std::to_string(t[0] + 1) + " " + std::to_string(t[1] + 1) + " " + std::to_string(t[2] + 1) + "\n";
       off += "3 " + std::to_string(t[0]) + " " + std::to_string(t[1]) + " " + std::to_string(t[2]) + "\n";
     }
+    std::string stl = "solid book\n";
+    for (const Tri& t : b.faces) {
+      stl += "facet normal 0 0 0\nouter loop\n";
+      for (int v : t)
+        stl += "vertex " + std::to_string(b.vertices[v].x()) + " " + std::to_string(b.vertices[v].y()) + " " +
+               std::to_string(b.vertices[v].z()) + "\n";
+      stl += "endloop\nendfacet\n";
+    }
+    test::WriteBytes(dir_ / "book3.stl", stl + "endsolid book\n");
     test::WriteBytes(dir_ / "book3.obj", obj);
     test::WriteBytes(dir_ / "book3.off", off);
     test::WriteBytes(dir_ / "garbage.off", "OFF\n4 2 0\n0 0 0\n1 0\n");
@@ -478,7 +487,7 @@ class EvaluateExe : public ::testing::Test {
 };
 
 TEST_F(EvaluateExe, PrintsOneJsonLineReadsEveryFormatAndWritesAtomically) {
-  for (const char* ref : {"book3.ply", "book3.obj", "book3.off"}) {
+  for (const char* ref : {"book3.ply", "book3.obj", "book3.off", "book3.stl"}) {
     const auto r = RunProgram("evaluate", Args("book3.ply", ref));
     ASSERT_EQ(r.exit_code, 0) << r.err;
     EXPECT_NE(r.out.find("\"td\": 0, \"nmcd_x1e3\": 0,"), std::string::npos) << ref << ": " << r.out;
