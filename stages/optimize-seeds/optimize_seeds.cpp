@@ -29,7 +29,7 @@ void OptimizeSeedsOptions::Check() const {
   if (!(repulsion_cutoff >= 1.0 && repulsion_cutoff <= 10.0)) throw UsageError("--repulsion-cutoff must be in [1, 10]");
   if (!(l1_tol_rel > 0.0 && l1_tol_rel < 0.1)) throw UsageError("--l1-tol-rel must be in (0, 0.1)");
   if (l1_max_sweeps < 1) throw UsageError("--l1-max-sweeps must be at least 1");
-  if (!(move_tol_rel >= 0.0 && move_tol_rel < 0.1)) throw UsageError("--move-tol-rel must be in [0, 0.1)");
+  if (!(move_tol >= 0.0 && move_tol < 1.0)) throw UsageError("--move-tol must be in [0, 1)");
   if (!(proj_tol_rel > 0.0 && proj_tol_rel < 0.1)) throw UsageError("--proj-tol-rel must be in (0, 0.1)");
   if (proj_max_iters < 1) throw UsageError("--proj-max-iters must be at least 1");
 }
@@ -197,18 +197,22 @@ class Optimizer {
     return moved;
   }
 
-  double MinimumSpacing(const std::vector<Vec3>& positions) const {
-    const SeedIndex index(positions);
-    const long n = static_cast<long>(positions.size());
+  // Alg. 1 line 4: σ = the minimum pairwise seed distance — over pairs that repulsion can change, i.e. with
+  // at least one seed that may move (rank < 3). Two fixed seeds (a corner and a seed beside it whose cell
+  // also sees three planes) would otherwise pin σ, and with it every seed's repulsion, at their distance.
+  double MinimumSpacing(const State& s) const {
+    const SeedIndex index(s.position);
+    const long n = static_cast<long>(s.position.size());
     std::vector<double> nearest(static_cast<size_t>(n), INFINITY);
 #pragma omp parallel
     {
       std::vector<int> knn;
 #pragma omp for schedule(static)
       for (long i = 0; i < n; ++i) {
-        index.Nearest(positions[i], 2, knn);
+        if (s.space[i].dim == 0) continue;
+        index.Nearest(s.position[i], 2, knn);
         for (int j : knn)
-          if (j != i) nearest[i] = std::min(nearest[i], (positions[static_cast<size_t>(j)] - positions[i]).norm());
+          if (j != i) nearest[i] = std::min(nearest[i], (s.position[static_cast<size_t>(j)] - s.position[i]).norm());
       }
     }
     return *std::min_element(nearest.begin(), nearest.end());
@@ -337,13 +341,17 @@ SeedCloud OptimizeSeeds(const Udf& udf, const SeedCloud& input, const OptimizeSe
       const std::vector<Vec3> before = s.position;
       const double l1_move = opt.Project(s, before, opt.L1Step(s, cells), 0.5 * sigma);
       task.Advance();
-      // Line 4: the kernel width.
-      report.sigma = sigma = opt.MinimumSpacing(s.position);
-      // Lines 5–15: repulsion rounds.
+      // Lines 4–15: the kernel width, then repulsion rounds. σ is computed right after the first round's
+      // cells, so that the movable/fixed split it depends on is the one the round uses.
       double previous_gradient = -1.0;
       for (int inner = 1; inner <= options.max_inner_iters; ++inner) {
         const auto t0 = Clock::now();
         opt.Analyze(s);
+        if (inner == 1) {
+          report.sigma = opt.MinimumSpacing(s);
+          if (!std::isfinite(report.sigma)) break;  // every seed is fixed: nothing to repel
+          sigma = report.sigma;
+        }
         const auto t1 = Clock::now();
         const NeighbourLists neighbours = opt.RepulsionNeighbours(s.position, options.repulsion_cutoff * report.sigma);
         const RepulsionResult r = MinimizeRepulsion(s.position, s.space, neighbours, report.sigma, repulsion);
@@ -376,7 +384,7 @@ SeedCloud OptimizeSeeds(const Udf& udf, const SeedCloud& input, const OptimizeSe
                  "/" + std::to_string(report.rank_count[2]) + "/" + std::to_string(report.rank_count[3]) +
                  Format(", cell acceptance %.2f, %.2f s", opt.last_acceptance(), report.seconds));
     if (on_iteration) on_iteration(report, ToCloud(s));
-    if (report.max_inner_move <= options.move_tol_rel * opt.diagonal()) {
+    if (report.max_inner_move <= options.move_tol * report.sigma) {
       monitor.Info("converged: the inner loop made no update");
       break;
     }

@@ -18,14 +18,14 @@ struct OptimizeSeedsOptions {
   int max_outer_iters = 10;       ///< cap on Alg. 1's outer loop (--max-outer-iters)
   int max_inner_iters = 10;       ///< cap on Alg. 1's inner loop (--max-inner-iters)
   int lbfgs_max_iters = 50;       ///< L-BFGS iterations per inner round (Ceres' default) (--lbfgs-max-iters)
-  double rank_threshold = 0.25;   ///< τ: rank(A) = #{singular values > τ·s_1} (--rank-threshold)
+  double rank_threshold = 0.4;    ///< τ: rank(A) = #{singular values > τ·s_1} (--rank-threshold)
   int cell_knn = 6;               ///< the cell's bounding ball has radius cell_radius_factor × distance to the k-th nearest seed (--cell-knn)
   double cell_radius_factor = 0.5;///< (--cell-radius-factor)
   double max_step = 0.5;          ///< trust region: a repulsion round moves a seed at most this many σ (--max-step)
   double repulsion_cutoff = 3.0;  ///< neighbours interact within this many σ (kernel 1.1e-2 at 3σ) (--repulsion-cutoff)
   double l1_tol_rel = 1e-6;       ///< L1 step solved to this position accuracy (relative to the diagonal) (--l1-tol-rel)
   int l1_max_sweeps = 2000;       ///< dual coordinate-ascent sweeps before the L1 step gives up (--l1-max-sweeps)
-  double move_tol_rel = 1e-6;     ///< an inner loop moving no seed farther than this (relative) "makes no update" (--move-tol-rel)
+  double move_tol = 1e-3;         ///< an inner loop moving no seed farther than move_tol·σ "makes no update" (--move-tol)
   double proj_tol_rel = 1e-5;     ///< projection tolerance on d, relative to the diagonal (as sample-seeds) (--proj-tol-rel)
   int proj_max_iters = 50;        ///< projection steps before a move is undone (--proj-max-iters)
 
@@ -52,7 +52,7 @@ struct OuterIterationReport {
 /// tangent-plane matrix, Gaussian repulsion over neighbours within repulsion_cutoff·σ minimised with L-BFGS
 /// in the null spaces (repulsion.h), projection — until the projected gradient's norm changes by less than δ
 /// relatively or max_inner_iters. The outer loop ends when an inner loop moves no seed farther than
-/// move_tol_rel·diagonal, or after max_outer_iters. Finally ranks are recomputed at the final positions.
+/// move_tol·σ, or after max_outer_iters (σ is taken over pairs with at least one movable seed). Finally ranks are recomputed at the final positions.
 /// Output seeds lie on the zero set (d < proj_tol_rel·diagonal) with their UDF value, gradient and rank.
 /// `on_iteration` (optional) sees the seeds after every outer iteration (for --trace).
 /// Deterministic for given inputs and options, also across thread counts (fixed-order reductions,

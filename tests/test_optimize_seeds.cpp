@@ -1,0 +1,529 @@
+// optimize-seeds: the L1 tangent solver against known optima and brute force, the tangent-plane rank, the
+// projected repulsion, the whole optimisation on built-in shapes, and the real executable end to end.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <functional>
+#include <set>
+
+#include "common/errors.h"
+#include "common/projection.h"
+#include "common/rng.h"
+#include "common/shapes.h"
+#include "formats/mesh_io.h"
+#include "formats/seeds_io.h"
+#include "stages/optimize-seeds/l1_tangent.h"
+#include "stages/optimize-seeds/optimize_seeds.h"
+#include "stages/optimize-seeds/repulsion.h"
+#include "stages/optimize-seeds/seed_index.h"
+#include "stages/optimize-seeds/voronoi_cells.h"
+#include "stages/sample-seeds/sample_seeds.h"
+#include "tests/support/test_support.h"
+
+namespace voroudf {
+namespace {
+
+using test::RunProgram;
+using test::TempDir;
+
+// ---------------------------------------------------------------------------------------------- L1 solver
+
+// Samples of exact tangent planes through the origin with normals `planes`, seen from random points around
+// x0 (as UDF samples of the surface would be: n = ±plane normal, d = |distance|), in coordinates centred on x0.
+L1TangentProblem PlanesProblem(const std::vector<Vec3>& planes, const Vec3& x0, int per_plane, double gamma) {
+  L1TangentProblem p;
+  p.gamma = gamma;
+  Rng rng(7, 0);
+  for (const Vec3& n : planes) {
+    for (int k = 0; k < per_plane; ++k) {
+      const Vec3 q = x0 + Vec3(rng.Uniform(-0.1, 0.1), rng.Uniform(-0.1, 0.1), rng.Uniform(-0.1, 0.1));
+      const double signed_distance = n.dot(q);
+      const Vec3 a = signed_distance >= 0 ? n : Vec3(-n);
+      p.a.push_back(a);
+      p.b.push_back(a.dot(q - x0) - std::abs(signed_distance));
+    }
+  }
+  return p;
+}
+
+L1TangentOptions Tight() {
+  L1TangentOptions o;
+  o.gap_tolerance = 1e-14;
+  o.max_sweeps = 20000;
+  return o;
+}
+
+TEST(L1Tangent, TwoPlanesPutTheOptimumOnTheirEdge) {
+  const Vec3 x0(0.02, -0.03, 0.04);
+  const auto p = PlanesProblem({Vec3::UnitX(), Vec3::UnitY()}, x0, 50, 10.0);
+  const auto s = SolveL1Tangent(p, Tight());
+  ASSERT_TRUE(s.converged);
+  const Vec3 x = x0 + s.y;
+  // Separable objective: 50|x| + 50|y| + γ‖x − x0‖² → x = y = 0 (soft threshold 2.5 ≫ |x0|), z = x0.z.
+  EXPECT_NEAR(x.x(), 0.0, 1e-6);
+  EXPECT_NEAR(x.y(), 0.0, 1e-6);
+  EXPECT_NEAR(x.z(), x0.z(), 1e-6);
+  EXPECT_LE(s.dual, s.primal);
+}
+
+TEST(L1Tangent, ThreePlanesPutTheOptimumOnTheirCorner) {
+  const Vec3 x0(0.03, 0.01, -0.02);
+  const Vec3 tilted = Vec3(1.0, 1.0, 1.0).normalized();  // not orthogonal: coordinates are coupled
+  const auto p = PlanesProblem({Vec3::UnitX(), Vec3::UnitY(), tilted}, x0, 30, 10.0);
+  const auto s = SolveL1Tangent(p, Tight());
+  ASSERT_TRUE(s.converged);
+  EXPECT_LT((x0 + s.y).norm(), 1e-6);
+}
+
+TEST(L1Tangent, ABindingConstraintPutsTheOptimumOnTheCellBoundary) {
+  const Vec3 x0(0.1, 0.05, 0.3);
+  auto p = PlanesProblem({Vec3::UnitX(), Vec3::UnitY()}, x0, 50, 10.0);
+  // The cell: x ≥ 0.06 (in centred coordinates −y_x ≤ 0.04), plus a loose one that must stay inactive.
+  p.c = {-Vec3::UnitX(), Vec3::UnitZ()};
+  p.h = {0.04, 0.5};
+  const auto s = SolveL1Tangent(p, Tight());
+  ASSERT_TRUE(s.converged);
+  const Vec3 x = x0 + s.y;
+  EXPECT_NEAR(x.x(), 0.06, 1e-6);
+  EXPECT_NEAR(x.y(), 0.0, 1e-6);
+  EXPECT_NEAR(x.z(), 0.3, 1e-6);
+  EXPECT_LE(p.c[0].dot(s.y), p.h[0] + 1e-12);
+}
+
+TEST(L1Tangent, MatchesBruteForceGridSearchOnRandomInstances) {
+  for (uint64_t trial = 0; trial < 25; ++trial) {
+    Rng rng(99, trial);
+    L1TangentProblem p;
+    p.gamma = rng.Uniform(0.5, 20.0);
+    const int m = 3 + static_cast<int>(rng.Below(12));
+    for (int k = 0; k < m; ++k) {
+      p.a.push_back(Vec3(rng.Uniform(-1, 1), rng.Uniform(-1, 1), rng.Uniform(-1, 1)).normalized());
+      p.b.push_back(rng.Uniform(-0.3, 0.3));
+    }
+    const int constraints = static_cast<int>(rng.Below(5));
+    for (int k = 0; k < constraints; ++k) {
+      p.c.push_back(Vec3(rng.Uniform(-1, 1), rng.Uniform(-1, 1), rng.Uniform(-1, 1)).normalized());
+      p.h.push_back(rng.Uniform(0.01, 0.2));
+    }
+    const auto s = SolveL1Tangent(p, Tight());
+    ASSERT_TRUE(s.converged) << "trial " << trial;
+    for (size_t k = 0; k < p.c.size(); ++k) EXPECT_LE(p.c[k].dot(s.y), p.h[k] + 1e-12);
+    EXPECT_NEAR(s.primal, L1TangentObjective(p, s.y), 1e-12);
+
+    // Grid search over the feasible set, coarse then twice finer around the best point. The optimum lies
+    // in the ball ‖y‖ ≤ sqrt(P(0)/γ) because P(y*) ≤ P(0).
+    auto feasible = [&](const Vec3& y) {
+      for (size_t k = 0; k < p.c.size(); ++k)
+        if (p.c[k].dot(y) > p.h[k]) return false;
+      return true;
+    };
+    Vec3 centre = Vec3::Zero();
+    double half = std::sqrt(L1TangentObjective(p, Vec3::Zero()) / p.gamma);
+    double best = INFINITY;
+    const int steps = 40;
+    for (int level = 0; level < 3; ++level) {
+      Vec3 best_y = centre;
+      for (int i = 0; i <= steps; ++i)
+        for (int j = 0; j <= steps; ++j)
+          for (int k = 0; k <= steps; ++k) {
+            const Vec3 y = centre + half * Vec3(2.0 * i / steps - 1, 2.0 * j / steps - 1, 2.0 * k / steps - 1);
+            if (!feasible(y)) continue;
+            const double v = L1TangentObjective(p, y);
+            if (v < best) best = v, best_y = y;
+          }
+      centre = best_y;
+      half *= 4.0 / steps;
+    }
+    // The solver is at least as good as the grid, and the grid cannot beat the dual bound.
+    EXPECT_LE(s.primal, best + 1e-12) << "trial " << trial;
+    EXPECT_GE(best, s.dual - 1e-12) << "trial " << trial;
+    EXPECT_LE(s.primal - s.dual, 1e-14) << "trial " << trial;
+  }
+}
+
+TEST(L1Tangent, NoSamplesNoMove) {
+  L1TangentProblem p;
+  p.c = {Vec3::UnitX()};
+  p.h = {0.1};
+  const auto s = SolveL1Tangent(p, Tight());
+  EXPECT_TRUE(s.converged);
+  EXPECT_EQ(s.y, Vec3::Zero());
+}
+
+// ---------------------------------------------------------------------------------------------- rank
+
+TEST(TangentRank, CountsThePlanesAndGivesTheirNullSpace) {
+  std::vector<Vec3> sheet(40, Vec3(0, 0, 1));
+  for (size_t k = 0; k < sheet.size(); k += 2) sheet[k] = -sheet[k];  // both sides of the sheet
+  auto r = ComputeTangentRank(sheet.data(), sheet.size(), 0.25);
+  EXPECT_EQ(r.rank, 1);
+  EXPECT_NEAR(std::abs(r.v.col(0).z()), 1.0, 1e-12);
+  EXPECT_NEAR(r.v.col(1).z(), 0.0, 1e-12);
+  EXPECT_NEAR(r.v.col(2).z(), 0.0, 1e-12);
+
+  std::vector<Vec3> edge(sheet);
+  for (size_t k = 0; k < 15; ++k) edge.push_back(Vec3(1, 0, 0));
+  r = ComputeTangentRank(edge.data(), edge.size(), 0.25);
+  EXPECT_EQ(r.rank, 2);
+  EXPECT_NEAR(std::abs(r.v.col(2).y()), 1.0, 1e-12);  // the edge direction
+
+  std::vector<Vec3> corner(edge);
+  for (size_t k = 0; k < 10; ++k) corner.push_back(Vec3(0, 1, 0));
+  EXPECT_EQ(ComputeTangentRank(corner.data(), corner.size(), 0.25).rank, 3);
+
+  // A few stray normals stay below the threshold: s2/s1 = sqrt(2/40) < 0.25.
+  std::vector<Vec3> almost(sheet);
+  almost.push_back(Vec3(1, 0, 0));
+  almost.push_back(Vec3(1, 0, 0));
+  EXPECT_EQ(ComputeTangentRank(almost.data(), almost.size(), 0.25).rank, 1);
+  EXPECT_EQ(ComputeTangentRank(almost.data(), 0, 0.25).rank, 0);
+}
+
+// ---------------------------------------------------------------------------------------------- repulsion
+
+std::vector<Vec3> RandomPoints(size_t n, uint64_t seed, double extent) {
+  std::vector<Vec3> p(n);
+  for (size_t i = 0; i < n; ++i) {
+    Rng rng(seed, i);
+    p[i] = Vec3(rng.Uniform(-extent, extent), rng.Uniform(-extent, extent), rng.Uniform(-extent, extent));
+  }
+  return p;
+}
+
+NeighbourLists AllPairs(size_t n) {
+  std::vector<std::pair<int, int>> pairs;
+  for (size_t i = 0; i < n; ++i)
+    for (size_t j = i + 1; j < n; ++j) pairs.emplace_back(static_cast<int>(i), static_cast<int>(j));
+  return NeighbourLists::FromPairs(n, pairs);
+}
+
+TEST(Repulsion, GradientMatchesFiniteDifferences) {
+  const auto x = RandomPoints(12, 3, 0.1);
+  const auto lists = AllPairs(x.size());
+  const double sigma = 0.05;
+  std::vector<Vec3> g;
+  const double e = RepulsionEnergy(x, lists, sigma, &g);
+  EXPECT_GT(e, 0.0);
+  for (size_t i = 0; i < x.size(); ++i)
+    for (int d = 0; d < 3; ++d) {
+      auto plus = x, minus = x;
+      plus[i][d] += 1e-6;
+      minus[i][d] -= 1e-6;
+      const double fd = (RepulsionEnergy(plus, lists, sigma, nullptr) - RepulsionEnergy(minus, lists, sigma, nullptr)) / 2e-6;
+      EXPECT_NEAR(g[i][d], fd, 1e-5 * std::max(1.0, std::abs(fd)));
+    }
+}
+
+TEST(Repulsion, NeighbourListsAreSymmetric) {
+  const auto lists = NeighbourLists::FromPairs(4, {{0, 1}, {2, 1}, {1, 0}, {3, 3}});
+  EXPECT_EQ(lists.offset, (std::vector<size_t>{0, 1, 3, 4, 4}));
+  EXPECT_EQ(lists.index, (std::vector<int>{1, 0, 2, 1}));
+}
+
+TEST(Repulsion, SeedsMoveOnlyInTheirNullSpaceAndTheEnergyDrops) {
+  // Seeds on the line y = z = 0 allowed to move along x only, plus free seeds off the line.
+  std::vector<Vec3> x;
+  std::vector<MoveSpace> spaces;
+  for (int i = 0; i < 8; ++i) {
+    x.emplace_back(0.01 * i + 0.002 * (i % 3), 0.0, 0.0);
+    MoveSpace s;
+    s.dim = 1;
+    s.basis.col(0) = Vec3::UnitX();
+    spaces.push_back(s);
+  }
+  for (const Vec3& p : RandomPoints(5, 4, 0.05)) {
+    x.push_back(p);
+    MoveSpace s;
+    s.dim = 3;
+    s.basis.setIdentity();
+    spaces.push_back(s);
+  }
+  MoveSpace fixed;  // rank 3: does not move
+  x.emplace_back(0.035, 0.001, 0.0);
+  spaces.push_back(fixed);
+  const auto lists = AllPairs(x.size());
+  RepulsionOptions options;
+  const auto r = MinimizeRepulsion(x, spaces, lists, 0.01, options);
+  EXPECT_LT(r.final_energy, 0.5 * r.initial_energy);
+  EXPECT_GT(r.iterations, 0);
+  EXPECT_NEAR(r.final_energy, RepulsionEnergy(r.positions, lists, 0.01, nullptr), 1e-9);
+  for (int i = 0; i < 8; ++i) {
+    EXPECT_EQ(r.positions[i].y(), 0.0);
+    EXPECT_EQ(r.positions[i].z(), 0.0);
+  }
+  EXPECT_EQ(r.positions.back(), x.back());
+  bool moved = false;
+  for (int i = 0; i < 8; ++i) moved |= std::abs(r.positions[i].x() - x[i].x()) > 1e-4;
+  EXPECT_TRUE(moved);
+  // The trust region bounds every displacement.
+  options.max_step = 0.3;
+  const auto clamped = MinimizeRepulsion(x, spaces, lists, 0.01, options);
+  for (size_t i = 0; i < x.size(); ++i) EXPECT_LE((clamped.positions[i] - x[i]).norm(), 0.3 * 0.01 * (1 + 1e-12));
+  EXPECT_GT(clamped.clamped, 0u);
+}
+
+// Distance from p to the nearest of the cube's 12 edges and its 8 corners (cube [-0.5,0.5]^3).
+double CubeEdgeDistance(const Vec3& p) {
+  Vec3 q = p.cwiseAbs();
+  std::sort(q.data(), q.data() + 3);
+  return std::hypot(0.5 - q[1], 0.5 - q[2]);
+}
+double CubeCornerDistance(const Vec3& p) { return (p.cwiseAbs() - Vec3::Constant(0.5)).norm(); }
+
+TEST(Repulsion, ProjectedStepKeepsRankTwoSeedsOnTheCubeEdge) {
+  // Seeds on the edge x = y = 0.5 and on the two faces beside it; ranks and null spaces from real cell
+  // samples; a repulsion solve; every seed that the rank calls an edge seed stays on the edge line.
+  const auto cube = MakeShape("cube");
+  std::vector<Vec3> seeds;
+  for (int k = 0; k < 12; ++k) seeds.emplace_back(0.5, 0.5, -0.3 + 0.05 * k + 0.01 * (k % 2));
+  Rng rng(5, 0);
+  for (int k = 0; k < 60; ++k) {
+    const double t = rng.Uniform(0.04, 0.3), z = rng.Uniform(-0.35, 0.35);
+    seeds.push_back(k % 2 ? Vec3(0.5, 0.5 - t, z) : Vec3(0.5 - t, 0.5, z));
+  }
+  const SeedIndex index(seeds);
+  const CellSamples cells = SampleVoronoiCells(*cube, seeds, index, CellSamplingOptions(), 1, 0);
+  std::vector<MoveSpace> spaces(seeds.size());
+  int edge_seeds = 0;
+  for (size_t i = 0; i < seeds.size(); ++i) {
+    const auto r = ComputeTangentRank(cells.gradient.data() + cells.sample_offset[i],
+                                      cells.sample_offset[i + 1] - cells.sample_offset[i], 0.25);
+    spaces[i].dim = 3 - r.rank;
+    for (int d = 0; d < spaces[i].dim; ++d) spaces[i].basis.col(d) = r.v.col(r.rank + d);
+    if (i < 12) {
+      EXPECT_EQ(r.rank, 2) << "edge seed " << i;
+      edge_seeds += r.rank == 2;
+    }
+  }
+  ASSERT_GT(edge_seeds, 8);
+  std::vector<std::pair<int, int>> pairs;
+  for (size_t i = 0; i < seeds.size(); ++i)
+    for (size_t j = i + 1; j < seeds.size(); ++j)
+      if ((seeds[i] - seeds[j]).norm() < 0.15) pairs.emplace_back(static_cast<int>(i), static_cast<int>(j));
+  const auto lists = NeighbourLists::FromPairs(seeds.size(), pairs);
+  const auto r = MinimizeRepulsion(seeds, spaces, lists, 0.04, RepulsionOptions());
+  ASSERT_GT(r.iterations, 0);
+  std::vector<Vec3> moved = r.positions;
+  ProjectionOptions proj;
+  proj.tolerance = 1e-9;
+  ProjectToZeroSet(*cube, moved, proj, Monitor::Null());
+  double slid = 0.0;
+  for (int i = 0; i < 12; ++i) {
+    if (spaces[i].dim != 1) continue;
+    EXPECT_LT(CubeEdgeDistance(r.positions[i]), 1e-12) << "seed " << i << " left the edge";
+    EXPECT_LT(CubeEdgeDistance(moved[i]), 1e-12);
+    slid = std::max(slid, std::abs(r.positions[i].z() - seeds[i].z()));
+  }
+  EXPECT_GT(slid, 1e-3) << "the edge seeds did not move along the edge at all";
+}
+
+// ---------------------------------------------------------------------------------------------- shapes
+
+double NearestNeighbourCv(const std::vector<Vec3>& p, double* mean_out = nullptr) {
+  std::vector<double> nn(p.size(), INFINITY);
+  for (size_t i = 0; i < p.size(); ++i)
+    for (size_t j = 0; j < p.size(); ++j)
+      if (i != j) nn[i] = std::min(nn[i], (p[i] - p[j]).norm());
+  double mean = 0, var = 0;
+  for (double d : nn) mean += d;
+  mean /= static_cast<double>(nn.size());
+  for (double d : nn) var += (d - mean) * (d - mean);
+  if (mean_out) *mean_out = mean;
+  return std::sqrt(var / static_cast<double>(nn.size())) / mean;
+}
+
+SeedCloud Initial(const Udf& udf, size_t count, uint64_t seed) {
+  SampleSeedsOptions o;
+  o.count = count;
+  o.seed = seed;
+  return SampleSeeds(udf, o, Monitor::Null());
+}
+
+TEST(OptimizeSeeds, CubeSeedsFindTheEdgesAndCornersAndSpreadEvenly) {
+  const auto cube = MakeShape("cube");
+  const SeedCloud in = Initial(*cube, 800, 3);
+  OptimizeSeedsOptions options;
+  options.seed = 1;
+  const SeedCloud out = OptimizeSeeds(*cube, in, options, Monitor::Null());
+  ASSERT_GT(out.size(), 790u);
+  const double diag = cube->Domain().Diagonal();
+  const double tol = 1e-5 * diag;
+  std::set<std::array<int, 3>> corners;
+  std::vector<int> per_edge(12, 0);
+  size_t rank2 = 0, rank2_on_edge = 0;
+  double mean_nn = 0.0;
+  const double cv_out = NearestNeighbourCv(out.position, &mean_nn);
+  for (size_t i = 0; i < out.size(); ++i) {
+    const Vec3& p = out.position[i];
+    ASSERT_LT(cube->Distance(p), tol) << "seed " << i << " is off the surface";
+    EXPECT_NEAR(out.normal[i].norm(), 1.0, 1e-9);
+    EXPECT_GE(out.rank[i], 1);
+    if (out.rank[i] == 3) {
+      EXPECT_LT(CubeCornerDistance(p), tol) << "rank-3 seed away from the corners";
+      corners.insert({p.x() > 0, p.y() > 0, p.z() > 0});
+    }
+    if (out.rank[i] == 2) {
+      ++rank2;
+      const double e = CubeEdgeDistance(p);
+      EXPECT_LT(e, 0.5 * mean_nn) << "rank-2 seed far from every edge";
+      if (e < tol) {
+        ++rank2_on_edge;
+        // Which edge: the axis along which |p| is not 0.5.
+        const Vec3 q = p.cwiseAbs();
+        int axis = 0;
+        for (int k = 1; k < 3; ++k)
+          if (q[k] < q[axis]) axis = k;
+        const int a = (axis + 1) % 3, b = (axis + 2) % 3;
+        ++per_edge[4 * axis + 2 * (p[a] > 0) + (p[b] > 0)];
+      }
+    }
+  }
+  EXPECT_EQ(corners.size(), 8u) << "corners recovered";
+  EXPECT_GE(static_cast<double>(rank2_on_edge), 0.95 * static_cast<double>(rank2));
+  for (int e = 0; e < 12; ++e) EXPECT_GE(per_edge[e], 5) << "edge " << e;
+  const double cv_in = NearestNeighbourCv(in.position);
+  EXPECT_LT(cv_out, cv_in / 2.0) << "spacing not more uniform: CV " << cv_in << " -> " << cv_out;
+}
+
+// Every rank-2 seed lies on one of the feature curves (distance given by `feature`), and at least
+// `min_on_curve` seeds lie on the curve measured by `curve` (the non-manifold one).
+void ExpectRankTwoOnFeatures(const std::string& shape, const std::function<double(const Vec3&)>& feature,
+                             const std::function<double(const Vec3&)>& curve, size_t min_on_curve) {
+  const auto udf = MakeShape(shape);
+  const SeedCloud in = Initial(*udf, 600, 4);
+  OptimizeSeedsOptions options;
+  options.max_outer_iters = 6;
+  const SeedCloud out = OptimizeSeeds(*udf, in, options, Monitor::Null());
+  const double tol = 1e-5 * udf->Domain().Diagonal();
+  double mean_nn = 0.0;
+  const double cv_out = NearestNeighbourCv(out.position, &mean_nn);
+  size_t rank2 = 0, on_feature = 0, on_curve = 0;
+  for (size_t i = 0; i < out.size(); ++i) {
+    ASSERT_LT(udf->Distance(out.position[i]), tol) << shape;
+    if (curve(out.position[i]) < tol) ++on_curve;
+    if (out.rank[i] != 2) continue;
+    ++rank2;
+    EXPECT_LT(feature(out.position[i]), 0.5 * mean_nn) << shape << ": rank-2 seed away from the features";
+    on_feature += feature(out.position[i]) < tol;
+  }
+  EXPECT_GE(static_cast<double>(on_feature), 0.9 * static_cast<double>(rank2)) << shape;
+  EXPECT_GE(on_curve, min_on_curve) << shape;
+  EXPECT_LT(cv_out, NearestNeighbourCv(in.position) / 2.0) << shape;
+}
+
+TEST(OptimizeSeeds, CrossingPlanesRankTwoSeedsOnTheIntersectionLineOrTheRims) {
+  // Squares [-0.5,0.5]^2 in z = 0 and x = 0: the line x = z = 0 (4 sheets), and the open rims.
+  auto line = [](const Vec3& p) { return std::hypot(p.x(), p.z()); };
+  auto rim = [](const Vec3& p) {
+    // Distance to the boundary of the square the point lies on, measured in that square's plane.
+    const double u = std::abs(p.z()) <= std::abs(p.x()) ? std::abs(p.x()) : std::abs(p.z());
+    return std::abs(std::min(0.5 - u, 0.5 - std::abs(p.y())));
+  };
+  ExpectRankTwoOnFeatures("crossing-planes", [&](const Vec3& p) { return std::min(line(p), rim(p)); }, line, 12);
+}
+
+TEST(OptimizeSeeds, SphereWithDiscRankTwoSeedsOnTheEquator) {
+  auto equator = [](const Vec3& p) { return std::hypot(std::hypot(p.x(), p.y()) - 0.5, p.z()); };
+  ExpectRankTwoOnFeatures("sphere-disc", equator, equator, 20);
+}
+
+TEST(OptimizeSeeds, BadOptionsAndInputs) {
+  OptimizeSeedsOptions o;
+  o.gamma = 0;
+  EXPECT_THROW(o.Check(), UsageError);
+  o = OptimizeSeedsOptions();
+  o.rank_threshold = 1.5;
+  EXPECT_THROW(o.Check(), UsageError);
+  const auto sphere = MakeShape("sphere");
+  SeedCloud one;
+  one.Resize(1);
+  EXPECT_THROW(OptimizeSeeds(*sphere, one, OptimizeSeedsOptions(), Monitor::Null()), InputError);
+  SeedCloud twins;
+  twins.Resize(2);
+  twins.position[0] = twins.position[1] = Vec3(0.5, 0, 0);
+  EXPECT_THROW(OptimizeSeeds(*sphere, twins, OptimizeSeedsOptions(), Monitor::Null()), InputError);
+}
+
+// ---------------------------------------------------------------------------------------------- executable
+
+class OptimizeSeedsExe : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    const auto r = RunProgram("sample-seeds", {"--udf", "shape:three-discs", "--count", "300", "--seed", "2", "-o", seeds0_});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+  }
+  std::vector<std::string> Args(const std::string& in, const std::string& out) {
+    return {"--udf", "shape:three-discs", "-i", in, "-o", out, "--max-outer-iters", "3"};
+  }
+  TempDir dir_;
+  TempDir inputs_;
+  std::string seeds0_ = inputs_ / "seeds0.ply";
+};
+
+TEST_F(OptimizeSeedsExe, WritesSeedsOnTheSurfaceWithRanksAndATrace) {
+  const std::string out = dir_ / "seeds.ply";
+  auto args = Args(seeds0_, out);
+  args.insert(args.end(), {"--trace", dir_ / "trace"});
+  const auto r = RunProgram("optimize-seeds", args);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(r.out.empty());
+  EXPECT_NE(r.err.find("outer 1:"), std::string::npos) << r.err;
+  const SeedCloud seeds = ReadSeeds(out);
+  EXPECT_EQ(seeds.size(), 300u);
+  const auto udf = MakeShape("three-discs");
+  size_t ranked = 0;
+  for (size_t i = 0; i < seeds.size(); ++i) {
+    EXPECT_LT(udf->Distance(seeds.position[i]), 1e-5 * udf->Domain().Diagonal() + 1e-6);
+    ranked += seeds.rank[i] >= 1;
+  }
+  EXPECT_EQ(ranked, seeds.size());
+  for (const char* name : {"iter-001.ply", "iter-002.ply", "iter-003.ply"})
+    EXPECT_EQ(ReadSeeds(dir_ / ("trace/" + std::string(name))).size(), 300u) << name;
+  EXPECT_NE(test::ReadBytes(out).find("comment stage optimize-seeds"), std::string::npos);
+}
+
+TEST_F(OptimizeSeedsExe, SameSeedSameBytesWhateverTheThreadCount) {
+  auto a = Args(seeds0_, dir_ / "a.ply");
+  auto b = Args(seeds0_, dir_ / "b.ply");
+  b.insert(b.end(), {"--threads", "1"});
+  auto c = Args(seeds0_, dir_ / "c.ply");
+  c.insert(c.end(), {"--seed", "9"});
+  ASSERT_EQ(RunProgram("optimize-seeds", a).exit_code, 0);
+  ASSERT_EQ(RunProgram("optimize-seeds", b).exit_code, 0);
+  ASSERT_EQ(RunProgram("optimize-seeds", c).exit_code, 0);
+  EXPECT_EQ(test::ReadBytes(dir_ / "a.ply"), test::ReadBytes(dir_ / "b.ply"));
+  EXPECT_NE(test::ReadBytes(dir_ / "a.ply"), test::ReadBytes(dir_ / "c.ply"));
+}
+
+TEST_F(OptimizeSeedsExe, BadInputsExitThreeAndLeaveNoFile) {
+  const std::string header = "ply\nformat ascii 1.0\nelement vertex ";
+  const std::string props = "\nproperty float x\nproperty float y\nproperty float z\nend_header\n";
+  test::WriteBytes(inputs_ / "empty.ply", header + "0" + props);
+  test::WriteBytes(inputs_ / "one.ply", header + "1" + props + "0.5 0 0\n");
+  test::WriteBytes(inputs_ / "nan.ply", header + "3" + props + "0.5 0 0\nnan 0 0\n0 0.5 0\n");
+  TriangleMesh mesh;
+  mesh.vertices = {Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0)};
+  mesh.faces = {{0, 1, 2}};
+  WriteMeshPly(inputs_ / "mesh.ply", mesh, Provenance{"test", "", ""});
+  for (const char* name : {"empty.ply", "one.ply", "nan.ply", "mesh.ply", "missing.ply"}) {
+    const auto r = RunProgram("optimize-seeds", Args(inputs_ / name, dir_ / "out.ply"));
+    EXPECT_EQ(r.exit_code, kExitBadInput) << name << ": " << r.err;
+    EXPECT_NE(r.err.find("optimize-seeds: error:"), std::string::npos) << r.err;
+    EXPECT_TRUE(dir_.List().empty()) << name << ": a failed run left a file behind";
+  }
+  const auto usage = RunProgram("optimize-seeds", {"--udf", "shape:cube", "-i", seeds0_, "-o", dir_ / "o.ply", "--gamma", "-1"});
+  EXPECT_EQ(usage.exit_code, kExitUsage) << usage.err;
+  EXPECT_TRUE(dir_.List().empty());
+}
+
+TEST_F(OptimizeSeedsExe, HelpExplainsTheOptions) {
+  const auto r = RunProgram("optimize-seeds", {"--help"});
+  EXPECT_EQ(r.exit_code, 0);
+  for (const char* flag : {"--udf", "--input", "--output", "--samples-per-cell", "--gamma", "--delta", "--trace",
+                           "--max-outer-iters", "--rank-threshold", "--seed", "--threads"})
+    EXPECT_NE(r.out.find(flag), std::string::npos) << flag;
+}
+
+}  // namespace
+}  // namespace voroudf
