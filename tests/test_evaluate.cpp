@@ -7,6 +7,7 @@
 #include <limits>
 
 #include "common/errors.h"
+#include "common/rng.h"
 #include "formats/mesh_io.h"
 #include "stages/evaluate/evaluate.h"
 #include "tests/support/test_support.h"
@@ -259,6 +260,25 @@ TEST(EvaluateSampling, AreaUniformOnTheFacesWithTheirNormalsAndThreadIndependent
   EXPECT_TRUE(SampleSurface(TriangleMesh{}, 10, 0, 0).points.empty());
   // Another stream gives other samples.
   EXPECT_NE(SampleSurface(m, 10, 7, 1u << 20).points[0], one.points[0]);
+}
+
+TEST(EvaluateSampling, NearestDistancesAreExactAgainstBruteForce) {
+  // Clustered random points (planes and a line), the worst case for a kd-tree's pruning.
+  std::vector<Vec3> a, b;
+  for (uint64_t i = 0; i < 3000; ++i) {
+    Rng r(3, i);
+    const double u = r.Uniform(), v = r.Uniform(), w = r.Uniform();
+    a.emplace_back(i % 3 == 0 ? Vec3(u, v, 0) : i % 3 == 1 ? Vec3(u, 0.5, v) : Vec3(u, 0.25, 0.25) + 0.01 * Vec3(0, v, w));
+    b.emplace_back(Vec3(v, w, u * u));
+  }
+  b.resize(2000);
+  const std::vector<double> d = NearestDistances(a, b, Monitor::Null());
+  ASSERT_EQ(d.size(), a.size());
+  for (size_t i = 0; i < a.size(); ++i) {
+    double best = std::numeric_limits<double>::infinity();
+    for (const Vec3& q : b) best = std::min(best, (a[i] - q).norm());
+    ASSERT_EQ(d[i], best) << i;
+  }
 }
 
 TEST(EvaluateSampling, ChamferAndHausdorffOfHandMadeSets) {

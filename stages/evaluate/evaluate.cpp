@@ -27,8 +27,7 @@ constexpr uint64_t kMeshStream = 1ull << 40;
 
 using KdIndex = flann::Index<flann::L2_Simple<double>>;
 
-// FLANN keeps its own reordered copy of the points (KDTreeSingleIndex reorders by default), so `rows`
-// may go once the index is built.
+// flann::Matrix only points at memory it does not own: the rows live as long as the index.
 struct KdTree {
   std::vector<double> rows;
   std::unique_ptr<KdIndex> index;
