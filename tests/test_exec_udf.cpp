@@ -1,0 +1,196 @@
+// exec: UDF sources (common/exec_udf.h, docs/exec-protocol.md): the Python reference server against
+// shape:sphere, concurrent queries, and fake servers that exit early, write garbage, answer the wrong count
+// or never answer, each of which must end in exit code 3 within the timeout, never a hang.
+#include <gtest/gtest.h>
+#include <omp.h>
+#include <signal.h>
+
+#include <chrono>
+#include <cmath>
+#include <thread>
+
+#include "common/errors.h"
+#include "common/exec_udf.h"
+#include "common/rng.h"
+#include "common/shapes.h"
+#include "common/udf_spec.h"
+#include "formats/seeds_io.h"
+#include "tests/support/test_support.h"
+
+namespace voroudf {
+namespace {
+
+using test::RunProgram;
+using test::TempDir;
+using Clock = std::chrono::steady_clock;
+
+const std::string kServer = std::string("/usr/bin/python3 ") + VOROUDF_SOURCE_DIR + "/pipelines/udf_server_sphere.py";
+
+// The handshake of a fake server in Python (struct only), followed by `body`.
+std::string FakeServer(const std::string& body) {
+  return "import struct, sys, time\n"
+         "out = sys.stdout.buffer\n"
+         "name = b'fake'\n"
+         "out.write(b'VUDF' + struct.pack('<I6fI', 1, -1, -1, -1, 1, 1, 1, len(name)) + name)\n"
+         "out.flush()\n" + body;
+}
+
+double Seconds(Clock::time_point since) { return std::chrono::duration<double>(Clock::now() - since).count(); }
+
+TEST(ExecUdf, ReferenceServerMatchesTheBuiltInSphere) {
+  ExecUdfOptions o;
+  o.max_batch = 1000;  // several requests per Evaluate
+  const ExecUdf udf(kServer, o);
+  EXPECT_EQ(udf.server_name(), "udf_server_sphere.py (sphere r=0.5)");
+  EXPECT_NEAR(udf.Domain().min.x(), -0.6, 1e-7);
+  EXPECT_NEAR(udf.Domain().max.z(), 0.6, 1e-7);
+  const auto sphere = MakeShape("sphere");
+  Rng rng(3, 3);
+  std::vector<Vec3> pts(5000);
+  for (Vec3& p : pts) p = Vec3(rng.Uniform(-0.6, 0.6), rng.Uniform(-0.6, 0.6), rng.Uniform(-0.6, 0.6)).cast<float>().cast<double>();
+  std::vector<double> d, de;
+  std::vector<Vec3> g, ge;
+  udf.Evaluate(pts, d, g);
+  sphere->Evaluate(pts, de, ge);
+  for (size_t i = 0; i < pts.size(); ++i) {
+    ASSERT_NEAR(d[i], de[i], 2e-7) << i;
+    ASSERT_LT((g[i] - ge[i]).norm(), 1e-6) << i;
+  }
+}
+
+TEST(ExecUdf, ConcurrentChunksFromManyThreadsAreSerialisedCorrectly) {
+  const ExecUdf udf(kServer, {});
+  const auto sphere = MakeShape("sphere");
+  const int n = 4000;
+  std::vector<Vec3> pts(n);
+  Rng rng(4, 4);
+  for (Vec3& p : pts) p = Vec3(rng.Uniform(-0.6, 0.6), rng.Uniform(-0.6, 0.6), rng.Uniform(-0.6, 0.6)).cast<float>().cast<double>();
+  std::vector<double> d(n);
+  std::vector<Vec3> g(n);
+#pragma omp parallel for num_threads(4) schedule(dynamic, 1)
+  for (int c = 0; c < n; c += 37) udf.EvaluateChunk(&pts[c], std::min(37, n - c), &d[c], &g[c]);
+  for (int i = 0; i < n; ++i) ASSERT_NEAR(d[i], sphere->Distance(pts[i]), 2e-7) << i;
+}
+
+TEST(ExecUdf, NormalizeWrapsAnExecSource) {
+  UdfSourceOptions o;
+  o.normalize = true;
+  const auto udf = OpenUdf("exec:" + kServer, o);  // box [-0.6,0.6]^3 -> [-0.5,0.5]^3, sphere radius 0.5/1.2
+  EXPECT_NEAR(udf->Domain().max.x(), 0.5, 1e-6);
+  EXPECT_NEAR(udf->Distance(Vec3(0.0, 0.0, 0.0)), 0.5 / 1.2, 1e-6);
+  EXPECT_NE(udf->Describe().find("--udf-normalize"), std::string::npos);
+}
+
+class FakeServers : public ::testing::Test {
+ protected:
+  std::string Script(const std::string& name, const std::string& body) {
+    test::WriteBytes(dir_ / name, body);
+    return "/usr/bin/python3 " + dir_ / name;
+  }
+  // Runs the library on a fake server: it must throw InputError naming `expect` within `limit_s` seconds.
+  void ExpectInputError(const std::string& command, const std::string& expect, double timeout_s = 1.0,
+                        double limit_s = 6.0) {
+    const auto start = Clock::now();
+    try {
+      ExecUdfOptions o;
+      o.timeout_s = timeout_s;
+      ExecUdf udf(command, o);
+      std::vector<Vec3> pts(10, Vec3(0.1, 0.2, 0.3));
+      std::vector<double> d;
+      std::vector<Vec3> g;
+      udf.Evaluate(pts, d, g);
+      ADD_FAILURE() << command << ": no error";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(expect), std::string::npos) << e.what();
+    }
+    EXPECT_LT(Seconds(start), limit_s) << command;
+  }
+  TempDir dir_;
+};
+
+TEST_F(FakeServers, EveryMisbehaviourIsAnInputErrorWithinTheTimeout) {
+  ExpectInputError(Script("early.py", FakeServer("sys.stdin.buffer.read(4)\nsys.exit(7)\n")), "exited with status 7");
+  ExpectInputError(Script("garbage.py", "import sys\nsys.stdout.write('hello, I am not a UDF server at all\\n' * 3)\n"
+                                        "sys.stdout.flush()\ntime = __import__('time')\ntime.sleep(30)\n"),
+                   "expected the magic 'VUDF'");
+  ExpectInputError(Script("silent.py", FakeServer("time.sleep(60)\n")), "--udf-timeout");
+  ExpectInputError(Script("nohandshake.py", "import time\ntime.sleep(60)\n"), "handshake");
+  ExpectInputError(Script("count.py", FakeServer(
+                       "n = struct.unpack('<I', sys.stdin.buffer.read(4))[0]\nsys.stdin.buffer.read(12 * n)\n"
+                       "out.write(struct.pack('<I', n + 1) + bytes(16 * (n + 1)))\nout.flush()\ntime.sleep(60)\n")),
+                   "wrong count");
+  ExpectInputError(Script("short.py", FakeServer(
+                       "n = struct.unpack('<I', sys.stdin.buffer.read(4))[0]\nsys.stdin.buffer.read(12 * n)\n"
+                       "out.write(struct.pack('<I', n) + bytes(8 * n))\nout.flush()\ntime.sleep(60)\n")),
+                   "--udf-timeout");
+  ExpectInputError(Script("nan.py", FakeServer(
+                       "n = struct.unpack('<I', sys.stdin.buffer.read(4))[0]\nsys.stdin.buffer.read(12 * n)\n"
+                       "out.write(struct.pack('<I', n) + struct.pack('<f', float('nan')) * (4 * n))\nout.flush()\n"
+                       "time.sleep(60)\n")),
+                   "non-finite");
+  ExpectInputError(Script("version.py", "import struct, sys\nsys.stdout.buffer.write(b'VUDF' + struct.pack('<I', 9) + bytes(40))\n"
+                                        "sys.stdout.flush()\n"),
+                   "version 9");
+  ExpectInputError("/nonexistent/udf-server", "exited with status 127");
+  ExpectInputError("", "no command");
+}
+
+TEST_F(FakeServers, AStalledServerIsKilledAndReaped) {
+  const std::string cmd = Script("pid.py", FakeServer("open(sys.argv[1], 'w').write(str(__import__('os').getpid()))\n"
+                                                      "time.sleep(60)\n")) + " " + dir_ / "pid";
+  ExecUdfOptions o;
+  o.timeout_s = 0.5;
+  {
+    ExecUdf udf(cmd, o);
+    EXPECT_THROW(udf.Distance(Vec3::Zero()), InputError);
+    // After an error every further query fails at once with the same error.
+    const auto start = Clock::now();
+    EXPECT_THROW(udf.Distance(Vec3::Zero()), InputError);
+    EXPECT_LT(Seconds(start), 0.1);
+  }
+  const pid_t pid = std::stoi(test::ReadBytes(dir_ / "pid"));
+  bool gone = false;
+  for (int i = 0; i < 200 && !gone; ++i) {
+    gone = kill(pid, 0) != 0;
+    if (!gone) std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  EXPECT_TRUE(gone) << "the server process " << pid << " is still there";
+}
+
+TEST_F(FakeServers, SampleSeedsEndsWithExitThreeWithinTheTimeoutAndNoOutput) {
+  const std::string cases[] = {
+      Script("early.py", FakeServer("sys.stdin.buffer.read(4)\nsys.exit(1)\n")),
+      Script("garbage.py", "import sys\nsys.stdout.write('garbage' * 100)\nsys.stdout.flush()\n"),
+      Script("silent.py", FakeServer("time.sleep(60)\n")),
+  };
+  for (const std::string& server : cases) {
+    const auto start = Clock::now();
+    const auto r = RunProgram("sample-seeds", {"--udf", "exec:" + server, "--udf-timeout", "1", "--count", "100", "-o",
+                                               dir_ / "seeds.ply"});
+    EXPECT_EQ(r.exit_code, 3) << server << "\n" << r.err;
+    EXPECT_LT(Seconds(start), 8.0) << server;
+    EXPECT_FALSE(test::Exists(dir_ / "seeds.ply"));
+    // One line: "sample-seeds: error: exec:...: ...".
+    EXPECT_NE(r.err.find("sample-seeds: error: exec:"), std::string::npos) << r.err;
+  }
+}
+
+TEST(ExecUdfExe, ReferenceServerGivesTheSameSeedsAsTheBuiltInSphere) {
+  TempDir dir;
+  const auto a = RunProgram("sample-seeds", {"--udf", "shape:sphere", "--count", "1000", "--seed", "8", "-o", dir / "a.ply"});
+  const auto b = RunProgram("sample-seeds", {"--udf", "exec:" + kServer, "--count", "1000", "--seed", "8", "-o", dir / "b.ply"});
+  ASSERT_EQ(a.exit_code, 0) << a.err;
+  ASSERT_EQ(b.exit_code, 0) << b.err;
+  EXPECT_NE(b.err.find("server 'udf_server_sphere.py (sphere r=0.5)'"), std::string::npos) << b.err;
+  const SeedCloud sa = ReadSeeds(dir / "a.ply"), sb = ReadSeeds(dir / "b.ply");
+  ASSERT_EQ(sa.size(), sb.size());
+  for (size_t i = 0; i < sa.size(); ++i) {
+    // float32 on the wire (points, distances) and the float32 box of the handshake: ~1e-7.
+    ASSERT_LT((sa.position[i] - sb.position[i]).norm(), 1e-5) << i;
+    // On the surface the normal may come out either way round (docs/udf-sources.md).
+    ASSERT_GT(std::abs(sa.normal[i].dot(sb.normal[i])), 1.0 - 1e-6) << i;
+  }
+}
+
+}  // namespace
+}  // namespace voroudf
