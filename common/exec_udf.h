@@ -43,6 +43,7 @@ class ExecUdf : public Udf {
 
   void EvaluateChunk(const Vec3* points, size_t count, double* distance, Vec3* gradient) const override;
   void Evaluate(const Vec3* points, size_t count, double* distance, Vec3* gradient) const override;
+  using Udf::Evaluate;
   Box Domain() const override { return domain_; }
   std::string Describe() const override;
 

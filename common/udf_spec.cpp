@@ -44,6 +44,7 @@ class NormalizedUdf : public Udf {
     inner_->Evaluate(original.data(), count, distance, gradient);
     for (size_t i = 0; i < count; ++i) distance[i] *= scale_;
   }
+  using Udf::Evaluate;
   Box Domain() const override { return domain_; }
   std::string Describe() const override {
     std::ostringstream out;
