@@ -355,6 +355,48 @@ TEST(EvaluateEcd, EdgePointsLieWithinTheRadiusOfTheCubeEdges) {
   }
 }
 
+TEST(EvaluateEcd, EdgePointsAreExactlyTheBruteForceDefinition) {
+  // 4000 samples in a 0.03 box (about 10 neighbours each within 0.004) on 40 "faces" of random normals.
+  SurfaceSamples s;
+  std::vector<Vec3> face_normal;
+  for (uint64_t f = 0; f < 40; ++f) {
+    Rng r(9, 100000 + f);
+    face_normal.push_back(Vec3(r.Uniform(-1, 1), r.Uniform(-1, 1), r.Uniform(-1, 1)).normalized());
+  }
+  for (uint64_t i = 0; i < 4000; ++i) {
+    Rng r(9, i);
+    s.points.emplace_back(r.Uniform(-0.015, 0.015), r.Uniform(-0.015, 0.015), r.Uniform(-0.015, 0.015));
+    s.faces.push_back(static_cast<int>(r.Below(40)));
+    s.normals.push_back(face_normal[s.faces.back()]);
+  }
+  std::vector<Vec3> expected;
+  for (size_t i = 0; i < s.points.size(); ++i)
+    for (size_t j = 0; j < s.points.size(); ++j)
+      if ((s.points[i] - s.points[j]).norm() < 0.004 && std::abs(s.normals[i].dot(s.normals[j])) < 0.2) {
+        expected.push_back(s.points[i]);
+        break;
+      }
+  const std::vector<Vec3> got = EdgePoints(s, 0.004, 0.2, Monitor::Null());
+  EXPECT_GT(expected.size(), 1000u);
+  EXPECT_LT(expected.size(), 4000u);
+  EXPECT_EQ(got, expected);
+  // Without face ids every sample is its own group: same answer.
+  s.faces.clear();
+  EXPECT_EQ(EdgePoints(s, 0.004, 0.2, Monitor::Null()), expected);
+}
+
+TEST(EvaluateEcd, TinyMeshDoesNotExhaustMemory) {
+  // A cube of side 1e-3 in the frame of a unit cube: all samples within 0.004 of one another (a radius
+  // search listing every neighbour would need 20000^2 indices, 1.6 GB). Every sample has a sample of a
+  // perpendicular face that close, so all are edge points. (Fewer samples than the default: the exact
+  // nearest-neighbour search of CD is quadratic when all of a set is almost equidistant from a query.)
+  EvaluateOptions o;
+  o.samples = 20000;
+  const Metrics m = Eval(Transformed(Cube(8), 1e-3, Vec3::Zero()), Cube(8), o);
+  EXPECT_EQ(m.mesh.edge_points, 20000u);
+  EXPECT_GT(m.ecd_x1e2, 70.0);  // the reference's edges are ~0.75 from the tiny cube
+}
+
 TEST(EvaluateEcd, MeshWithoutEdgePointsIsStoodInFor486PointsAtTheOrigin) {
   // Reference cube, mesh a sphere (no edge point): ECD = mean over the cube's edge points of |p| plus the
   // distance from the origin to the nearest of them. On the edges |p| = sqrt(1/2 + t^2), t in [-1/2, 1/2].

@@ -4,11 +4,13 @@
 #include <omp.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <limits>
 #include <memory>
+#include <unordered_map>
 #include <utility>
 
 #include "common/errors.h"
@@ -39,6 +41,14 @@ struct KdTree {
     index = std::make_unique<KdIndex>(flann::Matrix<double>(rows.data(), points.size(), 3),
                                       flann::KDTreeSingleIndexParams(10));
     index->buildIndex();
+  }
+};
+
+using Cell = std::array<long long, 3>;
+struct CellHash {
+  size_t operator()(const Cell& c) const {
+    return static_cast<size_t>(SplitMix64(static_cast<uint64_t>(c[0]) ^ SplitMix64(static_cast<uint64_t>(c[1]) ^
+                                                                                 SplitMix64(static_cast<uint64_t>(c[2])))));
   }
 };
 
@@ -197,6 +207,7 @@ SurfaceSamples SampleSurface(const TriangleMesh& mesh, size_t count, uint64_t se
   if (!(total > 0) || count == 0) return s;
   s.points.resize(count);
   s.normals.resize(count);
+  s.faces.resize(count);
 #pragma omp parallel for schedule(static)
   for (long long i = 0; i < static_cast<long long>(count); ++i) {
     Rng rng(seed, stream + static_cast<uint64_t>(i));
@@ -208,6 +219,7 @@ SurfaceSamples SampleSurface(const TriangleMesh& mesh, size_t count, uint64_t se
     const double su = std::sqrt(rng.Uniform()), v = rng.Uniform();
     s.points[i] = (1 - su) * mesh.vertices[t[0]] + su * (1 - v) * mesh.vertices[t[1]] + su * v * mesh.vertices[t[2]];
     s.normals[i] = normal[f];
+    s.faces[i] = static_cast<int>(f);
   }
   return s;
 }
@@ -257,29 +269,63 @@ std::vector<Vec3> EdgePoints(const SurfaceSamples& samples, double radius, doubl
   const size_t n = samples.points.size();
   std::vector<Vec3> edge;
   if (n == 0) return edge;
-  const KdTree tree(samples.points);
-  const flann::SearchParams params = ExactSearch();
-  std::vector<char> is_edge(n, 0);
-  const std::vector<size_t> order = MortonOrder(samples.points);
-  for (size_t begin = 0; begin < n; begin += kQueryBlock) {
-    const size_t end = std::min(n, begin + kQueryBlock);
-    std::vector<double> q = QueryRows(samples.points, order, begin, end);
-    std::vector<std::vector<int>> indices;
-    std::vector<std::vector<double>> dists;
-    // L2_Simple works on squared distances, so is its radius.
-    tree.index->radiusSearch(flann::Matrix<double>(q.data(), end - begin, 3), indices, dists,
-                             static_cast<float>(radius * radius), params);
+  if (!samples.faces.empty() && samples.faces.size() != n) throw Error("EdgePoints: one face per sample expected");
+  auto group = [&](size_t i) -> long long {
+    return samples.faces.empty() ? static_cast<long long>(i) : samples.faces[i];
+  };
+  // Cells of side 2 radius: the ball around a sample lies in the 2x2x2 cells on the side of its cell's
+  // centre it is on (8 hash look-ups per sample instead of 27 with cells of side radius).
+  const double side = 2 * radius;
+  std::vector<Cell> cell(n);
+  std::vector<std::array<signed char, 3>> toward(n);
 #pragma omp parallel for schedule(static)
-    for (long long i = static_cast<long long>(begin); i < static_cast<long long>(end); ++i) {
-      const Vec3& ni = samples.normals[order[i]];
-      for (int j : indices[i - begin])
-        if (std::abs(ni.dot(samples.normals[j])) < cos_threshold) {
-          is_edge[order[i]] = 1;
-          break;
-        }
+  for (long long i = 0; i < static_cast<long long>(n); ++i)
+    for (int k = 0; k < 3; ++k) {
+      const double x = samples.points[i][k] / side;
+      cell[i][k] = static_cast<long long>(std::floor(x));
+      toward[i][k] = x - std::floor(x) < 0.5 ? -1 : 1;
     }
-    monitor.Advance(end - begin);
+  std::vector<size_t> order(n);
+  for (size_t i = 0; i < n; ++i) order[i] = i;
+  std::sort(order.begin(), order.end(), [&](size_t x, size_t y) {
+    if (cell[x] != cell[y]) return cell[x] < cell[y];
+    if (group(x) != group(y)) return group(x) < group(y);
+    return x < y;
+  });
+  // Per cell its range in `order`; per position the end of its run of samples of one face.
+  std::unordered_map<Cell, std::pair<size_t, size_t>, CellHash> ranges;
+  std::vector<size_t> run_end(n);
+  for (size_t k = n; k-- > 0;) {
+    const bool same_run = k + 1 < n && cell[order[k + 1]] == cell[order[k]] && group(order[k + 1]) == group(order[k]);
+    run_end[k] = same_run ? run_end[k + 1] : k + 1;
   }
+  for (size_t k = 0; k < n;) {
+    size_t e = k + 1;
+    while (e < n && cell[order[e]] == cell[order[k]]) ++e;
+    ranges.emplace(cell[order[k]], std::make_pair(k, e));
+    k = e;
+  }
+  const double r2 = radius * radius;
+  std::vector<char> is_edge(n, 0);
+#pragma omp parallel for schedule(dynamic, 1024)
+  for (long long i = 0; i < static_cast<long long>(n); ++i) {
+    const Vec3& p = samples.points[i];
+    const Vec3& ni = samples.normals[i];
+    bool found = false;
+    for (int d = 0; d < 8 && !found; ++d) {
+      const Cell c{cell[i][0] + (d & 1) * toward[i][0], cell[i][1] + ((d >> 1) & 1) * toward[i][1],
+                   cell[i][2] + ((d >> 2) & 1) * toward[i][2]};
+      const auto it = ranges.find(c);
+      if (it == ranges.end()) continue;
+      for (size_t k = it->second.first; k < it->second.second && !found; k = run_end[k]) {
+        if (!(std::abs(ni.dot(samples.normals[order[k]])) < cos_threshold)) continue;
+        for (size_t m = k; m < run_end[k] && !found; ++m) found = (samples.points[order[m]] - p).squaredNorm() < r2;
+      }
+    }
+    is_edge[i] = found;
+    if ((i & 1023) == 1023) monitor.Advance(1024);
+  }
+  monitor.Advance(n % 1024);
   for (size_t i = 0; i < n; ++i)
     if (is_edge[i]) edge.push_back(samples.points[i]);
   return edge;

@@ -47,6 +47,7 @@ TriangleMesh ApplyFrame(const Frame& frame, const TriangleMesh& mesh);
 struct SurfaceSamples {
   std::vector<Vec3> points;
   std::vector<Vec3> normals;
+  std::vector<int> faces;  ///< the face each sample lies on (may be left empty for hand-made samples)
 };
 
 /// `count` area-uniform samples: face by the cumulative-area table, position by uniform barycentric
@@ -71,8 +72,13 @@ struct ChamferDistances {
 ChamferDistances Chamfer(const std::vector<Vec3>& a, const std::vector<Vec3>& b, Monitor& monitor);
 
 /// Edge points of the Neural Marching Cubes protocol (Chen & Zhang 2021): the samples that have another
-/// sample within `radius` whose normal makes |n.n'| < `cos_threshold` (sign-blind, as face orientation is
-/// arbitrary on open and non-manifold meshes). Returned in sample order.
+/// sample at distance < `radius` whose normal makes |n.n'| < `cos_threshold` (sign-blind, as face
+/// orientation is arbitrary on open and non-manifold meshes). Returned in sample order.
+/// Exact, with memory O(samples) whatever their density: a hash grid of cell 2 `radius`, samples grouped by
+/// face in each cell so that a face whose normal cannot qualify is skipped whole, and each sample stops at
+/// its first qualifying neighbour. (A radius search that lists every neighbour, as FLANN's does, needs
+/// samples^2 memory when a mesh is small against the reference's frame.)
+/// \pre samples.faces is empty or has one entry per point
 std::vector<Vec3> EdgePoints(const SurfaceSamples& samples, double radius, double cos_threshold, Monitor& monitor);
 
 /// Non-manifold edges: edges shared by 3 or more faces, in BuildEdgeFaces order.
