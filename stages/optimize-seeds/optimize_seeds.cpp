@@ -26,6 +26,7 @@ void OptimizeSeedsOptions::Check() const {
   if (cell_knn < 1 || cell_knn > 64) throw UsageError("--cell-knn must be in [1, 64]");
   if (!(cell_radius_factor > 0.0 && cell_radius_factor <= 10.0)) throw UsageError("--cell-radius-factor must be in (0, 10]");
   if (!(max_step >= 0.0 && max_step <= 100.0)) throw UsageError("--max-step must be in [0, 100]");
+  if (!(sigma_max_spacing >= 0.0 && sigma_max_spacing <= 10.0)) throw UsageError("--sigma-max-spacing must be in [0, 10]");
   if (!(repulsion_cutoff >= 1.0 && repulsion_cutoff <= 10.0)) throw UsageError("--repulsion-cutoff must be in [1, 10]");
   if (!(l1_tol_rel > 0.0 && l1_tol_rel < 0.1)) throw UsageError("--l1-tol-rel must be in (0, 0.1)");
   if (l1_max_sweeps < 1) throw UsageError("--l1-max-sweeps must be at least 1");
@@ -200,7 +201,10 @@ class Optimizer {
   // Alg. 1 line 4: σ = the minimum pairwise seed distance — over pairs that repulsion can change, i.e. with
   // at least one seed that may move (rank < 3). Two fixed seeds (a corner and a seed beside it whose cell
   // also sees three planes) would otherwise pin σ, and with it every seed's repulsion, at their distance.
-  double MinimumSpacing(const State& s) const {
+  // Capped at sigma_max_spacing × the mean nearest-neighbour distance: once the seeds are nearly even the
+  // minimum distance approaches the spacing itself, and a kernel that wide acts as a pressure that drives
+  // seeds against the features and open rims (docs/optimize-seeds.md, "Kernel width").
+  double KernelWidth(const State& s) const {
     const SeedIndex index(s.position);
     const long n = static_cast<long>(s.position.size());
     std::vector<double> nearest(static_cast<size_t>(n), INFINITY);
@@ -209,13 +213,18 @@ class Optimizer {
       std::vector<int> knn;
 #pragma omp for schedule(static)
       for (long i = 0; i < n; ++i) {
-        if (s.space[i].dim == 0) continue;
         index.Nearest(s.position[i], 2, knn);
         for (int j : knn)
           if (j != i) nearest[i] = std::min(nearest[i], (s.position[static_cast<size_t>(j)] - s.position[i]).norm());
       }
     }
-    return *std::min_element(nearest.begin(), nearest.end());
+    double minimum = INFINITY, sum = 0.0;
+    for (long i = 0; i < n; ++i) {
+      sum += nearest[i];
+      if (s.space[i].dim > 0) minimum = std::min(minimum, nearest[i]);
+    }
+    if (options_.sigma_max_spacing > 0.0) minimum = std::min(minimum, options_.sigma_max_spacing * sum / static_cast<double>(n));
+    return minimum;
   }
 
   NeighbourLists RepulsionNeighbours(const std::vector<Vec3>& positions, double radius) const {
@@ -348,7 +357,7 @@ SeedCloud OptimizeSeeds(const Udf& udf, const SeedCloud& input, const OptimizeSe
         const auto t0 = Clock::now();
         opt.Analyze(s);
         if (inner == 1) {
-          report.sigma = opt.MinimumSpacing(s);
+          report.sigma = opt.KernelWidth(s);
           if (!std::isfinite(report.sigma)) break;  // every seed is fixed: nothing to repel
           sigma = report.sigma;
         }

@@ -21,6 +21,7 @@ struct OptimizeSeedsOptions {
   double rank_threshold = 0.4;    ///< τ: rank(A) = #{singular values > τ·s_1} (--rank-threshold)
   int cell_knn = 6;               ///< the cell's bounding ball has radius cell_radius_factor × distance to the k-th nearest seed (--cell-knn)
   double cell_radius_factor = 0.5;///< (--cell-radius-factor)
+  double sigma_max_spacing = 0.5; ///< σ ≤ this × mean nearest-neighbour distance; 0: the paper's rule alone (--sigma-max-spacing)
   double max_step = 0.5;          ///< trust region: a repulsion round moves a seed at most this many σ (--max-step)
   double repulsion_cutoff = 3.0;  ///< neighbours interact within this many σ (kernel 1.1e-2 at 3σ) (--repulsion-cutoff)
   double l1_tol_rel = 1e-6;       ///< L1 step solved to this position accuracy (relative to the diagonal) (--l1-tol-rel)
