@@ -9,11 +9,14 @@
 #include <cmath>
 #include <cstdio>
 #include <functional>
+#include <iterator>
+#include <unordered_map>
 #include <numeric>
 #include <queue>
 #include <utility>
 
 #include "common/errors.h"
+#include "common/mesh_topology.h"
 #include "common/projection.h"
 #include "common/rng.h"
 
@@ -137,6 +140,20 @@ GvdResult BuildGvd(const Udf& udf, const SeedCloud& seeds, const BuildGvdOptions
   }
   const size_t total = static_cast<size_t>(std::llround(options.samples_per_seed * static_cast<double>(num_seeds)));
   const size_t in_space = static_cast<size_t>(std::llround(options.space_fraction * static_cast<double>(total)));
+  // Each seed's ball gets samples in proportion to radius^2, the area its ball covers on a sheet, so the
+  // sample density on the surface is even where the seeds are not (e.g. before optimisation, or on a torus'
+  // saddle, where uniform draws are sparse); ball_end[s] is one past seed s's last ball sample.
+  std::vector<size_t> ball_end(num_seeds);
+  {
+    double weight_total = 0.0;
+    for (size_t s = 0; s < num_seeds; ++s) weight_total += radius[s] * radius[s];
+    double prefix = 0.0;
+    for (size_t s = 0; s < num_seeds; ++s) {
+      prefix += radius[s] * radius[s];
+      ball_end[s] = static_cast<size_t>(std::llround(static_cast<double>(total - in_space) * prefix / weight_total));
+    }
+    ball_end[num_seeds - 1] = total - in_space;
+  }
   std::vector<Vec3> samples(total);
 #pragma omp parallel for schedule(static)
   for (long li = 0; li < static_cast<long>(total); ++li) {
@@ -146,8 +163,7 @@ GvdResult BuildGvd(const Udf& udf, const SeedCloud& seeds, const BuildGvdOptions
       for (int c = 0; c < 3; ++c) samples[i][c] = rng.Uniform(box.min[c], box.max[c]);
       continue;
     }
-    // Ball samples are dealt to the seeds round-robin so every seed gets the same share (+-1).
-    const size_t s = (i - in_space) % num_seeds;
+    const size_t s = static_cast<size_t>(std::upper_bound(ball_end.begin(), ball_end.end(), i - in_space) - ball_end.begin());
     Vec3 u;
     do {
       for (int c = 0; c < 3; ++c) u[c] = rng.Uniform(-1.0, 1.0);
@@ -313,6 +329,29 @@ GvdResult BuildGvd(const Udf& udf, const SeedCloud& seeds, const BuildGvdOptions
 
   // 5. Dual triangles. Per thread lists, then one sort: the result does not depend on the scheduling.
   std::vector<std::vector<Tri>> per_thread(static_cast<size_t>(omp_get_max_threads()));
+  auto neighbour_labels = [&](size_t u, std::vector<int>& out) {
+    for (size_t a = offset[u]; a < offset[u + 1]; ++a) out.push_back(label[static_cast<size_t>(adj[a])]);
+  };
+  auto emit = [](int i, int j, std::vector<int>& others, std::vector<Tri>& out) {
+    std::sort(others.begin(), others.end());
+    others.erase(std::unique(others.begin(), others.end()), others.end());
+    others.erase(std::remove_if(others.begin(), others.end(), [&](int l) { return l < 0 || l == i || l == j; }),
+                 others.end());
+    if (j >= 0) {
+      for (int k : others) {
+        Tri t{i, j, k};
+        std::sort(t.begin(), t.end());
+        out.push_back(t);
+      }
+      return;
+    }
+    for (size_t p = 0; p < others.size(); ++p)
+      for (size_t q = p + 1; q < others.size(); ++q) {
+        Tri t{i, others[p], others[q]};
+        std::sort(t.begin(), t.end());
+        out.push_back(t);
+      }
+  };
 #pragma omp parallel
   {
     std::vector<Tri>& out = per_thread[static_cast<size_t>(omp_get_thread_num())];
@@ -322,28 +361,63 @@ GvdResult BuildGvd(const Udf& udf, const SeedCloud& seeds, const BuildGvdOptions
       const size_t u = static_cast<size_t>(li);
       const int i = label[u];
       if (i < 0) continue;
+      // The paper's rule: u (label i) has neighbours labelled j and k.
       others.clear();
+      neighbour_labels(u, others);
+      emit(i, -1, others, out);
+      if (options.dual_rule != DualRule::kEdge) continue;
+      // The edge rule adds, for every graph edge (u, v) across a region border (labels i != j), the labels k
+      // seen by the neighbours of u or v: a junction of three regions is then found even where the samples
+      // leave a gap at it, which a lone sample's neighbourhood misses (holes in the mesh). It only adds
+      // triangles near junctions, which the thinning removes where they are extra.
       for (size_t a = offset[u]; a < offset[u + 1]; ++a) {
-        const int l = label[static_cast<size_t>(adj[a])];
-        if (l >= 0 && l != i) others.push_back(l);
+        const size_t v = static_cast<size_t>(adj[a]);
+        const int j = label[v];
+        if (j < 0 || j == i) continue;
+        others.clear();
+        neighbour_labels(u, others);
+        neighbour_labels(v, others);
+        emit(i, j, others, out);
       }
-      std::sort(others.begin(), others.end());
-      others.erase(std::unique(others.begin(), others.end()), others.end());
-      for (size_t p = 0; p < others.size(); ++p)
-        for (size_t q = p + 1; q < others.size(); ++q) {
-          Tri t{i, others[p], others[q]};
-          std::sort(t.begin(), t.end());
-          out.push_back(t);
-        }
     }
   }
   std::vector<Tri>& faces = result.thick.faces;
   for (auto& v : per_thread) faces.insert(faces.end(), v.begin(), v.end());
   std::sort(faces.begin(), faces.end());
   faces.erase(std::unique(faces.begin(), faces.end()), faces.end());
+  // 6. Junctions the samples skipped. Around a region, the neighbouring region can change from j to k along a
+  // path of samples none of which sees i, j and k at once (the random samples leave a gap right at the
+  // junction); the three borders then each get one triangle fewer than they should, and the mesh a triangular
+  // hole. Such a junction shows as three thick-mesh edges of one face each that form a cycle: add its triangle.
+  if (options.close_skipped_junctions) {
+    const EdgeFaces ef = BuildEdgeFaces(faces);
+    std::unordered_map<int, std::vector<int>> open;  // vertex -> other ends of its single-face edges
+    for (size_t e = 0; e < ef.edges.size(); ++e)
+      if (ef.faces[e].size() == 1) {
+        open[ef.edges[e][0]].push_back(ef.edges[e][1]);
+        open[ef.edges[e][1]].push_back(ef.edges[e][0]);
+      }
+    std::vector<Tri> added;
+    for (size_t e = 0; e < ef.edges.size(); ++e) {
+      if (ef.faces[e].size() != 1) continue;
+      const int a = ef.edges[e][0], b = ef.edges[e][1];
+      std::vector<int> na = open[a], nb = open[b];
+      std::sort(na.begin(), na.end());
+      std::sort(nb.begin(), nb.end());
+      std::vector<int> common;
+      std::set_intersection(na.begin(), na.end(), nb.begin(), nb.end(), std::back_inserter(common));
+      for (int c : common)
+        if (c > b) added.push_back({a, b, c});
+    }
+    stats.junctions_closed = added.size();
+    faces.insert(faces.end(), added.begin(), added.end());
+    std::sort(faces.begin(), faces.end());
+    faces.erase(std::unique(faces.begin(), faces.end()), faces.end());
+  }
   stats.triangles = faces.size();
   result.thick.vertices = seeds.position;
-  monitor.Info(Format("%zu dual triangles over %zu seeds", faces.size(), num_seeds));
+  monitor.Info(Format("%zu dual triangles over %zu seeds (%zu closing junctions the samples skipped)", faces.size(),
+                      num_seeds, stats.junctions_closed));
   if (faces.empty())
     throw NumericalError("no dual triangle: the Voronoi regions of the seeds never meet three at a time (too few "
                          "seeds, or the graph is pruned apart: check --eps-udf-rel and --eps-grad)");

@@ -14,6 +14,12 @@
 
 namespace voroudf {
 
+/// Which samples make a dual triangle (i, j, k) (see BuildGvd, step 5).
+enum class DualRule {
+  kSample,  ///< the paper's: a sample labelled i has graph neighbours labelled j and k
+  kEdge,    ///< also: a graph edge between labels i and j has an end with a neighbour labelled k
+};
+
 struct BuildGvdOptions {
   /// Dense samples drawn per seed before projection (--samples-per-seed). The kNN graph spans about
   /// sqrt(knn / samples_per_seed) seed spacings, and the wider it is, the more spurious 4-label junctions
@@ -32,6 +38,12 @@ struct BuildGvdOptions {
   double eps_udf_rel = 2e-3;
   /// An edge is pruned when |cos(edge, gradient)| at either endpoint exceeds this (--eps-grad).
   double eps_grad = 0.9;
+  /// Dual triangle rule (--dual-rule sample|edge): the paper's, or a superset that also looks across region
+  /// borders (more triangles near junctions, for sparse samples).
+  DualRule dual_rule = DualRule::kSample;
+  /// Adds the triangle of three single-face thick-mesh edges that form a cycle: a junction of three regions
+  /// that no sample saw (--close-skipped-junctions; BuildGvd step 6).
+  bool close_skipped_junctions = true;
   uint64_t seed = 0;           ///< RNG seed of the dense samples (--seed)
   double proj_tol_rel = 1e-5;  ///< samples converge once d < proj_tol_rel * diagonal (--proj-tol-rel)
   int proj_max_iters = 50;     ///< projection steps before a sample is dropped (--proj-max-iters)
@@ -51,6 +63,7 @@ struct BuildGvdStats {
   size_t edges_pruned_udf = 0;    ///< of those, pruned by the midpoint UDF test
   size_t edges_pruned_grad = 0;   ///< pruned by the gradient test (and not by the UDF test)
   size_t unreached = 0;           ///< nodes no seed reaches (label -1)
+  size_t junctions_closed = 0;    ///< triangles added by step 6
   size_t triangles = 0;
 };
 
@@ -64,7 +77,8 @@ struct GvdResult {
 /// triangles (paper Sec. 3.3).
 ///
 ///  1. samples_per_seed * N points: a space_fraction of them uniform in udf.Domain(), the rest uniform in a
-///     ball around each seed; each projected with x <- x - d n (common/projection.h); unconverged ones dropped.
+///     ball around each seed (radius: ball_scale x distance to its 6th-nearest seed; samples per ball in
+///     proportion to radius^2, so that the density on the surface is even); each projected with x <- x - d n (common/projection.h); unconverged ones dropped.
 ///     Point i draws from the counter-based stream (seed, i), so the draw does not depend on the threads.
 ///  2. The seeds join the samples as graph nodes (each labelled with its own index at distance 0: the seeds
 ///     are the sources of the sweep). Nodes are sorted along a Morton curve; a sample that shares a Morton
