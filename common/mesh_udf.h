@@ -42,6 +42,11 @@ class MeshUdf : public Udf {
   static std::unique_ptr<MeshUdf> Open(const std::string& path, const MeshUdfOptions& options = {});
 
   void EvaluateChunk(const Vec3* points, size_t count, double* distance, Vec3* gradient) const override;
+  /// Large batches are evaluated in Morton (Z-curve) order of the points, so that consecutive queries
+  /// touch the same BVH nodes and triangles (cache locality); results are written back in input order and
+  /// do not depend on the order (the traversal depends only on the query point).
+  void Evaluate(const Vec3* points, size_t count, double* distance, Vec3* gradient) const override;
+  using Udf::Evaluate;
   Box Domain() const override { return domain_; }
   std::string Describe() const override;
 

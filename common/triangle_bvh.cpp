@@ -131,7 +131,12 @@ TriangleBvh::TriangleBvh(const std::vector<Vec3>& vertices, const std::vector<Tr
   nodes_.reserve(2 * static_cast<size_t>(n));
   tris_.reserve(n);
   face_of_.reserve(n);
-  Build(order, 0, n, centroid, box, 0);
+  const ChildRef root = Build(order, 0, n, centroid, box, 0);
+  if (root.count > 0) {  // a single leaf: hang it under an inner root beside an empty box
+    nodes_.emplace_back();
+    SetChild(0, 0, root);
+    SetChild(0, 1, ChildRef{0, 0, Eigen::AlignedBox3d()});
+  }
 
   for (int slot = 0; slot < n; ++slot) {
     const Tri& t = faces[face_of_[slot]];
@@ -146,31 +151,28 @@ TriangleBvh::TriangleBvh(const std::vector<Vec3>& vertices, const std::vector<Tr
     const bool ok = pt.d00 > 0.0 && pt.d11 > 0.0 && det > kDegenerateSin2 * pt.d00 * pt.d11 &&
                     (ac - ab).squaredNorm() > 0.0;
     pt.inv_det = ok ? 1.0 / det : 0.0;
+    const Vec3 nrm = ok ? Vec3(ab.cross(ac).normalized()) : Vec3::Zero();
+    for (int k = 0; k < 3; ++k) pt.n[k] = nrm[k];
     if (!ok) ++num_degenerate_;
   }
 }
 
-int TriangleBvh::Build(std::vector<int>& order, int begin, int end, const std::vector<Vec3>& centroid,
+TriangleBvh::ChildRef TriangleBvh::Build(std::vector<int>& order, int begin, int end, const std::vector<Vec3>& centroid,
                        const std::vector<Eigen::AlignedBox3d>& box, int depth) {
   depth_ = std::max(depth_, depth + 1);
-  const int node = static_cast<int>(nodes_.size());
-  nodes_.emplace_back();
   Eigen::AlignedBox3d bounds, cbounds;
   for (int i = begin; i < end; ++i) {
     bounds.extend(box[order[i]]);
     cbounds.extend(centroid[order[i]]);
   }
-  for (int k = 0; k < 3; ++k) {
-    nodes_[node].lo[k] = RoundDown(bounds.min()[k]);
-    nodes_[node].hi[k] = RoundUp(bounds.max()[k]);
-  }
   const int count = end - begin;
   if (count <= kMaxLeafSize) {
-    nodes_[node].index = static_cast<int32_t>(face_of_.size());
-    nodes_[node].count = count;
+    const ChildRef leaf{static_cast<int32_t>(face_of_.size()), count, bounds};
     for (int i = begin; i < end; ++i) face_of_.push_back(order[i]);
-    return node;
+    return leaf;
   }
+  const int node = static_cast<int>(nodes_.size());
+  nodes_.emplace_back();
 
   // Binned SAH over the three axes (Wald 2007); the median split when the centroids coincide along
   // every axis (duplicate faces) or the tree is already deep.
@@ -224,12 +226,23 @@ int TriangleBvh::Build(std::vector<int>& order, int begin, int end, const std::v
     std::nth_element(order.begin() + begin, order.begin() + mid, order.begin() + end,
                      [&](int a, int b) { return centroid[a][axis] < centroid[b][axis] || (centroid[a][axis] == centroid[b][axis] && a < b); });
   }
-  Build(order, begin, mid, centroid, box, depth + 1);
-  const int right = Build(order, mid, end, centroid, box, depth + 1);
-  nodes_[node].index = right;
-  nodes_[node].count = 0;
-  return node;
+  SetChild(node, 0, Build(order, begin, mid, centroid, box, depth + 1));
+  SetChild(node, 1, Build(order, mid, end, centroid, box, depth + 1));
+  return ChildRef{node, 0, bounds};
 }
+
+void TriangleBvh::SetChild(int node, int c, const ChildRef& ref) {
+  Node& nd = nodes_[node];
+  nd.child[c] = ref.index;
+  nd.count[c] = ref.count;
+  for (int k = 0; k < 3; ++k) {
+    // An empty box (the missing sibling of a one-leaf tree) stays +inf/-inf: infinitely far, never visited.
+    nd.lo[c][k] = ref.box.isEmpty() ? std::numeric_limits<float>::infinity() : RoundDown(ref.box.min()[k]);
+    nd.hi[c][k] = ref.box.isEmpty() ? -std::numeric_limits<float>::infinity() : RoundUp(ref.box.max()[k]);
+  }
+}
+
+
 
 namespace {
 
@@ -248,8 +261,36 @@ TriangleBvh::Hit TriangleBvh::Closest(const Vec3& p) const {
   double bx = 0, by = 0, bz = 0;
   int best_slot = -1;
 
+  auto test_leaf = [&](int first, int count) {
+    for (int s = first, e = first + count; s < e; ++s) {
+      const PackedTri& t = tris_[s];
+      const double apx = px - t.a[0], apy = py - t.a[1], apz = pz - t.a[2];
+      // The distance to the triangle's plane bounds the distance from below: most triangles of a
+      // visited leaf are rejected by it without the region tests.
+      const double plane = apx * t.n[0] + apy * t.n[1] + apz * t.n[2];
+      if (plane * plane >= best) continue;
+      double qx, qy, qz;
+      if (t.inv_det != 0.0) {
+        const double d1 = t.ab[0] * apx + t.ab[1] * apy + t.ab[2] * apz;
+        const double d2 = t.ac[0] * apx + t.ac[1] * apy + t.ac[2] * apz;
+        double v, w;
+        EricsonBarycentric(d1, d2, t.d00, t.d01, t.d11, t.inv_det, &v, &w);
+        qx = t.a[0] + v * t.ab[0] + w * t.ac[0];
+        qy = t.a[1] + v * t.ab[1] + w * t.ac[1];
+        qz = t.a[2] + v * t.ab[2] + w * t.ac[2];
+      } else {
+        const Vec3 a(t.a[0], t.a[1], t.a[2]);
+        const Vec3 q = ClosestOnEdges(p, a, a + Vec3(t.ab[0], t.ab[1], t.ab[2]), a + Vec3(t.ac[0], t.ac[1], t.ac[2]));
+        qx = q.x(), qy = q.y(), qz = q.z();
+      }
+      const double dx = px - qx, dy = py - qy, dz = pz - qz;
+      const double sq = dx * dx + dy * dy + dz * dz;
+      if (sq < best) best = sq, bx = qx, by = qy, bz = qz, best_slot = s;
+    }
+  };
+
   struct Entry {
-    int node;
+    int32_t index, count;
     double sq;
   };
   Entry stack[kStackSize];
@@ -257,57 +298,46 @@ TriangleBvh::Hit TriangleBvh::Closest(const Vec3& p) const {
   int node = 0;
   for (;;) {
     const Node& nd = nodes_[node];
-    if (nd.count > 0) {
-      for (int s = nd.index, e = nd.index + nd.count; s < e; ++s) {
-        const PackedTri& t = tris_[s];
-        const double apx = px - t.a[0], apy = py - t.a[1], apz = pz - t.a[2];
-        double qx, qy, qz;
-        if (t.inv_det != 0.0) {
-          const double d1 = t.ab[0] * apx + t.ab[1] * apy + t.ab[2] * apz;
-          const double d2 = t.ac[0] * apx + t.ac[1] * apy + t.ac[2] * apz;
-          double v, w;
-          EricsonBarycentric(d1, d2, t.d00, t.d01, t.d11, t.inv_det, &v, &w);
-          qx = t.a[0] + v * t.ab[0] + w * t.ac[0];
-          qy = t.a[1] + v * t.ab[1] + w * t.ac[1];
-          qz = t.a[2] + v * t.ab[2] + w * t.ac[2];
-        } else {
-          const Vec3 a(t.a[0], t.a[1], t.a[2]);
-          const Vec3 q = ClosestOnEdges(p, a, a + Vec3(t.ab[0], t.ab[1], t.ab[2]), a + Vec3(t.ac[0], t.ac[1], t.ac[2]));
-          qx = q.x(), qy = q.y(), qz = q.z();
-        }
-        const double dx = px - qx, dy = py - qy, dz = pz - qz;
-        const double sq = dx * dx + dy * dy + dz * dz;
-        if (sq < best) best = sq, bx = qx, by = qy, bz = qz, best_slot = s;
-      }
-    } else {
-      const int left = node + 1, right = nd.index;
-      const double dl = BoxSqDistance(nodes_[left].lo, nodes_[left].hi, px, py, pz);
-      const double dr = BoxSqDistance(nodes_[right].lo, nodes_[right].hi, px, py, pz);
-      const bool left_first = dl <= dr;
-      const int near = left_first ? left : right, far = left_first ? right : left;
-      const double dnear = left_first ? dl : dr, dfar = left_first ? dr : dl;
-      if (dnear < best) {
-        if (dfar < best) stack[top++] = {far, dfar};
-        node = near;
+    const double d0 = BoxSqDistance(nd.lo[0], nd.hi[0], px, py, pz);
+    const double d1 = BoxSqDistance(nd.lo[1], nd.hi[1], px, py, pz);
+    const int nc = d1 < d0 ? 1 : 0;  // nearer child first; the left one on ties
+    const double dnear = nc ? d1 : d0, dfar = nc ? d0 : d1;
+    const int near_index = nd.child[nc], near_count = nd.count[nc];
+    const int far_index = nd.child[1 - nc], far_count = nd.count[1 - nc];
+    if (dnear < best) {
+      if (near_count == 0) {
+        if (dfar < best) stack[top++] = {far_index, far_count, dfar};
+        node = near_index;
         continue;
       }
-    }
-    // Pop the next box that can still hold something closer.
-    for (;;) {
-      if (top == 0) {
-        Hit hit;
-        hit.sq_distance = best;
-        hit.point = Vec3(bx, by, bz);
-        hit.face = best_slot >= 0 ? face_of_[best_slot] : -1;
-        return hit;
+      test_leaf(near_index, near_count);
+      if (dfar < best) {
+        if (far_count == 0) {
+          node = far_index;
+          continue;
+        }
+        test_leaf(far_index, far_count);
       }
+    }
+    // Pop the next box that can still hold something closer; leaves are tested on the spot.
+    node = -1;
+    while (top > 0) {
       const Entry e = stack[--top];
-      if (e.sq < best) {
-        node = e.node;
-        break;
+      if (!(e.sq < best)) continue;
+      if (e.count > 0) {
+        test_leaf(e.index, e.count);
+        continue;
       }
+      node = e.index;
+      break;
     }
+    if (node < 0) break;
   }
+  Hit hit;
+  hit.sq_distance = best;
+  hit.point = Vec3(bx, by, bz);
+  hit.face = best_slot >= 0 ? face_of_[best_slot] : -1;
+  return hit;
 }
 
 Vec3 TriangleBvh::FaceNormal(int face) const { return normal_[face]; }

@@ -5,8 +5,8 @@
 // bench_udf.cpp), but its generic kernel and traversal run several times slower than the pipeline's
 // budget (>= 1 M queries per second per core near the surface). This BVH keeps what makes the query fast:
 // binned-SAH splits, at most kMaxLeafSize triangles per leaf stored contiguously with their Ericson
-// coefficients precomputed, 32-byte nodes in one depth-first array (left child next to its parent), and a
-// nearest-child-first traversal that prunes boxes by squared distance.
+// coefficients and plane precomputed, 64-byte nodes holding both children's boxes in one flat array, and a
+// nearest-child-first traversal that prunes boxes (and triangles, by their plane) by squared distance.
 #include <cstdint>
 #include <vector>
 
@@ -50,22 +50,30 @@ class TriangleBvh {
   int depth() const { return depth_; }
 
  private:
-  // Leaf: count > 0, triangles [index, index + count) of tris_. Inner: count == 0, left child is the
-  // next node, right child is nodes_[index]. Float bounds, rounded outwards, keep a node at 32 bytes.
-  struct Node {
-    float lo[3];
+  // An inner node holds the boxes of its two children, so that choosing the nearer child reads one cache
+  // line. Child c is a leaf of count[c] > 0 triangles starting at slot child[c] of tris_, or (count 0) the
+  // inner node nodes_[child[c]]. Float bounds, rounded outwards, keep a node at 64 bytes.
+  struct alignas(64) Node {
+    float lo[2][3];
+    float hi[2][3];
+    int32_t child[2];
+    int32_t count[2];
+  };
+  struct ChildRef {
     int32_t index;
-    float hi[3];
     int32_t count;
+    Eigen::AlignedBox3d box;
   };
   // Triangle data in leaf order: a, b - a, c - a and the dot products Ericson's method reuses.
   struct PackedTri {
     double a[3], ab[3], ac[3];
     double d00, d01, d11, inv_det;  // inv_det = 1/(d00 d11 - d01^2); 0 marks a degenerate triangle
+    double n[3];                    // unit normal (zero if degenerate): (ap.n)^2 bounds the distance from below
   };
 
-  int Build(std::vector<int>& order, int begin, int end, const std::vector<Vec3>& centroid,
-            const std::vector<Eigen::AlignedBox3d>& box, int depth);
+  ChildRef Build(std::vector<int>& order, int begin, int end, const std::vector<Vec3>& centroid,
+                 const std::vector<Eigen::AlignedBox3d>& box, int depth);
+  void SetChild(int node, int c, const ChildRef& ref);
 
   std::vector<Node> nodes_;
   std::vector<PackedTri> tris_;
