@@ -81,7 +81,7 @@ uint64_t Spread21(uint64_t x) {
 
 void MeshUdf::Evaluate(const Vec3* points, size_t count, double* distance, Vec3* gradient) const {
   constexpr size_t kSortAbove = 4096;  // below this a batch fits the caches anyway
-  if (count < kSortAbove) {
+  if (count < kSortAbove || count > UINT32_MAX) {
     Udf::Evaluate(points, count, distance, gradient);
     return;
   }
