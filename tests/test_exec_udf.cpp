@@ -157,6 +157,22 @@ TEST_F(FakeServers, AStalledServerIsKilledAndReaped) {
   EXPECT_TRUE(gone) << "the server process " << pid << " is still there";
 }
 
+// Queries from inside an OpenMP region, as a stage's own parallel loop would make them.
+void QueryFromParallelRegion(const std::string& command) {
+  ExecUdf udf(command, {});
+  std::vector<Vec3> p(64, Vec3::Zero()), g(64);
+  std::vector<double> d(64);
+#pragma omp parallel for num_threads(2)
+  for (int c = 0; c < 64; c += 8) udf.EvaluateChunk(&p[c], 8, &d[c], &g[c]);
+  std::exit(0);
+}
+
+TEST_F(FakeServers, AFailureInsideAParallelRegionEndsTheProcessWithExitThree) {
+  GTEST_FLAG_SET(death_test_style, "threadsafe");
+  const std::string cmd = Script("early.py", FakeServer("sys.stdin.buffer.read(4)\nsys.exit(5)\n"));
+  EXPECT_EXIT(QueryFromParallelRegion(cmd), ::testing::ExitedWithCode(3), "error: exec:.*exited with status 5");
+}
+
 TEST_F(FakeServers, SampleSeedsEndsWithExitThreeWithinTheTimeoutAndNoOutput) {
   const std::string cases[] = {
       Script("early.py", FakeServer("sys.stdin.buffer.read(4)\nsys.exit(1)\n")),
