@@ -42,7 +42,7 @@ L1TangentSolution SolveL1Tangent(const L1TangentProblem& p, const L1TangentOptio
       const double aa = p.a[m].squaredNorm();
       if (aa == 0.0) continue;
       // dD/du_m = −a_mᵀw/(2γ) − b_m; curvature −‖a_m‖²/(2γ): the exact 1-D maximiser, clipped.
-      const double target = std::clamp(u[m] + (-p.a[m].dot(w) - two_gamma * p.b[m]) / aa, -1.0, 1.0);
+      const double target = std::clamp(u[m] + options.relaxation * (-p.a[m].dot(w) - two_gamma * p.b[m]) / aa, -1.0, 1.0);
       const double step = target - u[m];
       if (step == 0.0) continue;
       u[m] = target;
@@ -52,7 +52,7 @@ L1TangentSolution SolveL1Tangent(const L1TangentProblem& p, const L1TangentOptio
     for (size_t k = 0; k < k_count; ++k) {
       const double cc = p.c[k].squaredNorm();
       if (cc == 0.0) continue;
-      const double target = std::max(0.0, lambda[k] + (-p.c[k].dot(w) - two_gamma * p.h[k]) / cc);
+      const double target = std::max(0.0, lambda[k] + options.relaxation * (-p.c[k].dot(w) - two_gamma * p.h[k]) / cc);
       const double step = target - lambda[k];
       if (step == 0.0) continue;
       lambda[k] = target;

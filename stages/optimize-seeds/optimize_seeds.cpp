@@ -29,6 +29,7 @@ void OptimizeSeedsOptions::Check() const {
   if (!(sigma_max_spacing >= 0.0 && sigma_max_spacing <= 10.0)) throw UsageError("--sigma-max-spacing must be in [0, 10]");
   if (!(repulsion_cutoff >= 1.0 && repulsion_cutoff <= 10.0)) throw UsageError("--repulsion-cutoff must be in [1, 10]");
   if (!(l1_tol_rel > 0.0 && l1_tol_rel < 0.1)) throw UsageError("--l1-tol-rel must be in (0, 0.1)");
+  if (!(l1_relaxation > 0.0 && l1_relaxation < 2.0)) throw UsageError("--l1-relaxation must be in (0, 2)");
   if (l1_max_sweeps < 1) throw UsageError("--l1-max-sweeps must be at least 1");
   if (!(move_tol >= 0.0 && move_tol < 1.0)) throw UsageError("--move-tol must be in [0, 1)");
   if (!(proj_tol_rel > 0.0 && proj_tol_rel < 0.1)) throw UsageError("--proj-tol-rel must be in (0, 0.1)");
@@ -64,16 +65,32 @@ class Optimizer {
   }
 
   // Projects `moved` onto the zero set; a seed whose projection fails goes back to `previous` (which is on
-  // the surface). So does a seed that lands within `min_separation` of another seed (both, if both moved):
-  // projection is not injective (everything beyond a cube corner lands on the corner), and two seeds
-  // that meet would make σ, the minimum pairwise distance, collapse for every seed. Returns the largest
-  // displacement from `previous`.
+  // the surface). So does a seed that lands nearer to another seed than min(min_separation, the distance to
+  // its nearest neighbour before the move) (both seeds, if both moved): projection is not injective
+  // (everything beyond a cube corner lands on the corner; L1 steps of neighbours meet on a feature at their
+  // common cell face), and seeds that meet would make σ, the minimum pairwise distance, shrink for every
+  // seed, iteration after iteration. Returns the largest displacement from `previous`.
   double Project(State& s, const std::vector<Vec3>& previous, std::vector<Vec3> moved, double min_separation) {
     const size_t n = moved.size();
     ProjectionResult r = ProjectToZeroSet(udf_, moved, projection_, Monitor::Null());
     std::vector<char> accept(r.converged);
     const size_t failed = n - r.num_converged;
-    const double floor = std::max(min_separation, 1e-9 * diagonal_);
+    std::vector<double> floor(n, min_separation);
+    {
+      const SeedIndex before(previous);
+#pragma omp parallel
+      {
+        std::vector<int> knn;
+#pragma omp for schedule(static)
+        for (long li = 0; li < static_cast<long>(n); ++li) {
+          const size_t i = static_cast<size_t>(li);
+          before.Nearest(previous[i], 2, knn);
+          for (int j : knn)
+            if (static_cast<size_t>(j) != i) floor[i] = std::min(floor[i], (previous[static_cast<size_t>(j)] - previous[i]).norm());
+          floor[i] = std::max(floor[i], 1e-9 * diagonal_);
+        }
+      }
+    }
     size_t separated = 0;
     for (int pass = 0; pass < 64; ++pass) {
       std::vector<Vec3> trial(n);
@@ -87,9 +104,9 @@ class Optimizer {
         for (long li = 0; li < static_cast<long>(n); ++li) {
           const size_t i = static_cast<size_t>(li);
           if (!accept[i] || moved[i] == previous[i]) continue;
-          index.WithinRadius(trial[i], floor * (1.0 + 1e-5) + 1e-12, found);
+          index.WithinRadius(trial[i], floor[i] * (1.0 + 1e-5) + 1e-12, found);
           for (int j : found)
-            if (static_cast<size_t>(j) != i && (trial[static_cast<size_t>(j)] - trial[i]).norm() < floor) reject[i] = 1;
+            if (static_cast<size_t>(j) != i && (trial[static_cast<size_t>(j)] - trial[i]).norm() < floor[i]) reject[i] = 1;
         }
       }
       const size_t rejected = static_cast<size_t>(std::count(reject.begin(), reject.end(), 1));
@@ -146,10 +163,11 @@ class Optimizer {
   // Paper Eq. (energy_l1_regularizer) for every seed, inside its cell. Returns the new (unprojected) positions.
   std::vector<Vec3> L1Step(const State& s, const CellSamples& cells) {
     const long n = static_cast<long>(s.position.size());
-    const double inv_l = 1.0 / diagonal_;
     L1TangentOptions solver;
+    // Lengths relative to the diagonal: ‖y − y*‖ ≤ sqrt(gap/γ) ≤ l1_tol_rel.
     solver.gap_tolerance = options_.gamma * options_.l1_tol_rel * options_.l1_tol_rel;
     solver.max_sweeps = options_.l1_max_sweeps;
+    solver.relaxation = options_.l1_relaxation;
     std::vector<Vec3> moved(s.position);
     std::vector<int> sweeps(static_cast<size_t>(n), 0);
     std::vector<char> converged(static_cast<size_t>(n), 1);
@@ -160,6 +178,10 @@ class Optimizer {
 #pragma omp for schedule(dynamic, 32)
       for (long i = 0; i < n; ++i) {
         const Vec3& x0 = s.position[i];
+        // Lengths relative to the domain diagonal (DESIGN.md), so γ means the same for any scale of the
+        // shape; the paper's shapes are normalised to about unit size, where its γ = 10 was chosen.
+        const double scale = diagonal_;
+        const double inv_l = 1.0 / scale;
         problem.Clear();
         for (size_t m = cells.sample_offset[i]; m < cells.sample_offset[i + 1]; ++m) {
           const Vec3& g = cells.gradient[m];
@@ -184,7 +206,7 @@ class Optimizer {
           }
         }
         const L1TangentSolution solution = SolveL1Tangent(problem, solver);
-        moved[i] = x0 + diagonal_ * solution.y;
+        moved[i] = x0 + scale * solution.y;
         sweeps[i] = solution.sweeps;
         converged[i] = solution.converged;
       }
@@ -225,6 +247,23 @@ class Optimizer {
     }
     if (options_.sigma_max_spacing > 0.0) minimum = std::min(minimum, options_.sigma_max_spacing * sum / static_cast<double>(n));
     return minimum;
+  }
+
+  double MeanSpacing(const std::vector<Vec3>& positions) const {
+    const SeedIndex index(positions);
+    const long n = static_cast<long>(positions.size());
+    std::vector<double> nearest(static_cast<size_t>(n), 0.0);
+#pragma omp parallel
+    {
+      std::vector<int> knn;
+#pragma omp for schedule(static)
+      for (long i = 0; i < n; ++i) {
+        index.Nearest(positions[i], 2, knn);
+        for (int j : knn)
+          if (j != i) nearest[i] = (positions[static_cast<size_t>(j)] - positions[i]).norm();
+      }
+    }
+    return std::accumulate(nearest.begin(), nearest.end(), 0.0) / static_cast<double>(n);
   }
 
   NeighbourLists RepulsionNeighbours(const std::vector<Vec3>& positions, double radius) const {
@@ -338,7 +377,6 @@ SeedCloud OptimizeSeeds(const Udf& udf, const SeedCloud& input, const OptimizeSe
   RepulsionOptions repulsion;
   repulsion.max_iterations = options.lbfgs_max_iters;
   repulsion.max_step = options.max_step;
-  double sigma = 0.0;  // kernel width of the previous outer iteration (0 before the first)
   for (int outer = 1; outer <= options.max_outer_iters; ++outer) {
     const auto outer_start = Clock::now();
     OuterIterationReport report;
@@ -348,7 +386,7 @@ SeedCloud OptimizeSeeds(const Udf& udf, const SeedCloud& input, const OptimizeSe
       // Alg. 1 line 3: the L1 tangent step, then back onto the zero set.
       const CellSamples cells = opt.Analyze(s);
       const std::vector<Vec3> before = s.position;
-      const double l1_move = opt.Project(s, before, opt.L1Step(s, cells), 0.5 * sigma);
+      const double l1_move = opt.Project(s, before, opt.L1Step(s, cells), 0.25 * opt.MeanSpacing(s.position));
       task.Advance();
       // Lines 4–15: the kernel width, then repulsion rounds. σ is computed right after the first round's
       // cells, so that the movable/fixed split it depends on is the one the round uses.
@@ -359,7 +397,6 @@ SeedCloud OptimizeSeeds(const Udf& udf, const SeedCloud& input, const OptimizeSe
         if (inner == 1) {
           report.sigma = opt.KernelWidth(s);
           if (!std::isfinite(report.sigma)) break;  // every seed is fixed: nothing to repel
-          sigma = report.sigma;
         }
         const auto t1 = Clock::now();
         const NeighbourLists neighbours = opt.RepulsionNeighbours(s.position, options.repulsion_cutoff * report.sigma);
