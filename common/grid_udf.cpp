@@ -105,25 +105,34 @@ Stencil AxisStencil(double u, size_t n) {
 }  // namespace
 
 NpyArray ReadNpyFloat32(const std::string& path) {
-  const std::string bytes = ReadAll(path);
-  if (bytes.size() < 10 || std::memcmp(bytes.data(), "\x93NUMPY", 6) != 0)
+  // The header is read first and the data straight into the array: a 512^3 grid is 512 MB, no copy.
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(path, std::string("cannot open: ") + std::strerror(errno));
+  in.seekg(0, std::ios::end);
+  const size_t file_size = static_cast<size_t>(in.tellg());
+  in.seekg(0);
+  char preamble[12] = {0};
+  in.read(preamble, std::min<size_t>(12, file_size));
+  if (file_size < 10 || std::memcmp(preamble, "\x93NUMPY", 6) != 0)
     throw InputError(path, "not a NumPy .npy file (no \\x93NUMPY magic)");
-  const int major = static_cast<unsigned char>(bytes[6]);
+  const int major = static_cast<unsigned char>(preamble[6]);
   size_t header_len, offset;
   if (major == 1) {
-    header_len = static_cast<unsigned char>(bytes[8]) | (static_cast<size_t>(static_cast<unsigned char>(bytes[9])) << 8);
+    header_len = static_cast<unsigned char>(preamble[8]) | (static_cast<size_t>(static_cast<unsigned char>(preamble[9])) << 8);
     offset = 10;
   } else if (major == 2 || major == 3) {
-    if (bytes.size() < 12) throw InputError(path, "truncated NumPy header");
+    if (file_size < 12) throw InputError(path, "truncated NumPy header");
     uint32_t len;
-    std::memcpy(&len, bytes.data() + 8, 4);
+    std::memcpy(&len, preamble + 8, 4);
     header_len = len;
     offset = 12;
   } else {
     throw InputError(path, "unsupported .npy format version " + std::to_string(major) + " (expected 1, 2 or 3)");
   }
-  if (bytes.size() < offset + header_len) throw InputError(path, "truncated NumPy header");
-  const std::string header = bytes.substr(offset, header_len);
+  if (file_size < offset + header_len) throw InputError(path, "truncated NumPy header");
+  std::string header(header_len, '\0');
+  in.seekg(static_cast<std::streamoff>(offset));
+  in.read(header.data(), static_cast<std::streamsize>(header_len));
   offset += header_len;
 
   std::string descr = HeaderValue(header, "descr", path);
@@ -155,13 +164,15 @@ NpyArray ReadNpyFloat32(const std::string& path) {
     count *= s;
   }
   const size_t need = count * sizeof(float);
-  if (bytes.size() - offset < need)
+  if (file_size - offset < need)
     throw InputError(path, "truncated: shape " + shape_text + " needs " + std::to_string(need) + " data bytes, the file has " +
-                               std::to_string(bytes.size() - offset));
-  if (bytes.size() - offset > need)
-    throw InputError(path, "has " + std::to_string(bytes.size() - offset - need) + " bytes after the array of shape " + shape_text);
+                               std::to_string(file_size - offset));
+  if (file_size - offset > need)
+    throw InputError(path, "has " + std::to_string(file_size - offset - need) + " bytes after the array of shape " + shape_text);
   array.data.resize(count);
-  std::memcpy(array.data.data(), bytes.data() + offset, need);  // the machine is little-endian (x86-64, arm64)
+  // The machine is little-endian (x86-64, arm64), like '<f4'.
+  in.read(reinterpret_cast<char*>(array.data.data()), static_cast<std::streamsize>(need));
+  if (!in) throw InputError(path, "read error in the array data");
   return array;
 }
 

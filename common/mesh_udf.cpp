@@ -118,8 +118,12 @@ std::string MeshUdf::Describe() const {
   if (bvh_->num_degenerate() > 0) out << ", " << bvh_->num_degenerate() << " degenerate";
   out << "; bbox " << FormatBox(bbox_);
   if (options_.normalize) {
-    out << " after --udf-normalize (x - [" << original_center_.x() << "," << original_center_.y() << ","
+    // Full precision: users map results back with x = c + x' / scale.
+    std::ostringstream map;
+    map.precision(17);
+    map << " after --udf-normalize x' = (x - [" << original_center_.x() << "," << original_center_.y() << ","
         << original_center_.z() << "]) * " << scale_;
+    out << map.str();
   }
   out << "; domain " << FormatBox(domain_) << " = bbox + " << options_.margin_rel << " * max extent)";
   return out.str();

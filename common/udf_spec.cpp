@@ -48,6 +48,7 @@ class NormalizedUdf : public Udf {
   Box Domain() const override { return domain_; }
   std::string Describe() const override {
     std::ostringstream out;
+    out.precision(17);  // users map results back with x = c + x' / scale
     out << inner_->Describe() << "; --udf-normalize: x' = (x - [" << center_.x() << "," << center_.y() << ","
         << center_.z() << "]) * " << scale_ << ", domain " << FormatBox(domain_);
     return out.str();

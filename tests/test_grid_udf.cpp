@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 
 #include "common/errors.h"
 #include "common/grid_udf.h"
@@ -225,6 +226,32 @@ TEST_F(GridFiles, WrongDtypeRankOrderBoxAndTruncationAreRefused) {
   nan[5] = NAN;
   WriteNpyFloat32(dir_ / "nan.npy", {4, 4, 4}, nan);
   EXPECT_THROW(OpenUdf(dir_ / "nan.npy", o), InputError);
+}
+
+TEST_F(GridFiles, ReadsWhatNumpyWritesWithTheDocumentedAxisConvention) {
+  // NumPy itself writes the file (np.save, meshgrid 'ij'), a field that differs along each axis.
+  const std::string script = dir_ / "make.py";
+  test::WriteBytes(script,
+                   "import numpy as np, sys\n"
+                   "xs, ys, zs = np.linspace(-1, 1, 9), np.linspace(0, 2, 11), np.linspace(-3, 1, 13)\n"
+                   "X, Y, Z = np.meshgrid(xs, ys, zs, indexing='ij')\n"
+                   "np.save(sys.argv[1] + '/lin.npy', (1 + 0.1 * X + 0.2 * Y + 0.05 * Z).astype(np.float32))\n"
+                   "np.save(sys.argv[1] + '/f8.npy', np.zeros((4, 4, 4)))\n"
+                   "np.save(sys.argv[1] + '/ft.npy', np.asfortranarray(np.zeros((4, 5, 6), np.float32)))\n");
+  ASSERT_EQ(std::system(("/usr/bin/python3 " + script + " " + dir_.path()).c_str()), 0);
+  UdfSourceOptions o;
+  o.grid_box = "-1,0,-3,1,2,1";
+  const auto udf = OpenUdf(dir_ / "lin.npy", o);
+  // d = 1 + 0.1 x + 0.2 y + 0.05 z is reproduced (d^2 is quadratic: Keys' kernel is exact) with its gradient.
+  Rng rng(9, 9);
+  for (int i = 0; i < 200; ++i) {
+    const Vec3 p = RandomIn(rng, udf->Domain());
+    Vec3 g;
+    EXPECT_NEAR(udf->Distance(p, &g), 1 + 0.1 * p.x() + 0.2 * p.y() + 0.05 * p.z(), 1e-6) << p.transpose();
+    EXPECT_LT((g - Vec3(0.1, 0.2, 0.05).normalized()).norm(), 1e-5);
+  }
+  EXPECT_THROW(OpenUdf(dir_ / "f8.npy", o), InputError);
+  EXPECT_THROW(OpenUdf(dir_ / "ft.npy", o), InputError);
 }
 
 TEST_F(GridFiles, SampleSeedsRunsOnAGridAndRefusesABadOne) {
