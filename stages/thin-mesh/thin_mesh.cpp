@@ -79,13 +79,21 @@ class Thinner {
     return tets;
   }
 
-  /// Fig. 8: removes the pair of faces of `tet` that share a manifold edge and whose centroids have the
-  /// largest summed UDF. Returns false (and removes nothing) when no pair shares a manifold edge.
-  bool ThinTetrahedron(const std::array<int, 4>& tet) {
+  struct Pair {
+    int fa = -1, fb = -1;
+    int holes = 5;       ///< edges the removal would leave with one face
+    double score = -1;   ///< summed centroid UDF
+    bool valid() const { return fa >= 0; }
+    /// Fewer new holes first, then the higher UDF.
+    bool Better(const Pair& o) const { return holes != o.holes ? holes < o.holes : score > o.score; }
+  };
+
+  /// Fig. 8: the pair of faces of `tet` that share a manifold edge and whose centroids have the largest
+  /// summed UDF; invalid when a face is gone or no pair shares a manifold edge.
+  Pair BestPair(const std::array<int, 4>& tet) const {
+    Pair best;
     for (int f : tet)
-      if (!alive_[static_cast<size_t>(f)]) return false;
-    int best_a = -1, best_b = -1, best_holes = 5;
-    double best = -1.0;
+      if (!alive_[static_cast<size_t>(f)]) return best;
     for (int p = 0; p < 4; ++p)
       for (int q = p + 1; q < 4; ++q) {
         const int fa = tet[static_cast<size_t>(p)], fb = tet[static_cast<size_t>(q)];
@@ -94,22 +102,34 @@ class Thinner {
         // Edges of the pair other than the shared one that would be left with one face: inside a surface a
         // tetrahedron's outer edges carry a face of the surface too, and the pair to remove is the one that
         // leaves none open. Only then (and for a lone tetrahedron, where every pair opens 4) the UDF decides.
-        int holes = 0;
+        Pair c{fa, fb, 0, udf_[static_cast<size_t>(fa)] + udf_[static_cast<size_t>(fb)]};
         for (int f : {fa, fb})
           for (int o : face_edges_[static_cast<size_t>(f)])
-            holes += (o != e && valence_[static_cast<size_t>(o)] == 2) ? 1 : 0;
-        const double score = udf_[static_cast<size_t>(fa)] + udf_[static_cast<size_t>(fb)];
-        if (holes < best_holes || (holes == best_holes && score > best)) {
-          best_holes = holes;
-          best = score;
-          best_a = fa;
-          best_b = fb;
-        }
+            c.holes += (o != e && valence_[static_cast<size_t>(o)] == 2) ? 1 : 0;
+        if (!best.valid() || c.Better(best)) best = c;
       }
-    if (best_a < 0) return false;
-    Remove(best_a);
-    Remove(best_b);
-    return true;
+    return best;
+  }
+
+  /// One pass over `tets`: the tetrahedra whose best pair is best go first (where several tetrahedra share
+  /// faces, as where 5+ Voronoi regions nearly meet, the order decides what is left), each re-evaluated
+  /// when its turn comes. Returns the number thinned.
+  size_t ThinPass(const std::vector<std::array<int, 4>>& tets) {
+    std::vector<std::pair<Pair, size_t>> order;
+    for (size_t t = 0; t < tets.size(); ++t) order.push_back({BestPair(tets[t]), t});
+    std::stable_sort(order.begin(), order.end(), [](const auto& x, const auto& y) {
+      if (x.first.valid() != y.first.valid()) return x.first.valid();
+      return x.first.valid() && x.first.Better(y.first);
+    });
+    size_t thinned = 0;
+    for (const auto& entry : order) {
+      const Pair p = BestPair(tets[entry.second]);
+      if (!p.valid()) continue;
+      Remove(p.fa);
+      Remove(p.fb);
+      ++thinned;
+    }
+    return thinned;
   }
 
   /// Components connected across manifold edges, as face lists (each in increasing face order): first those
@@ -296,8 +316,7 @@ TriangleMesh ThinMesh(const Udf& udf, const TriangleMesh& thick, const ThinMeshO
     for (;;) {
       const auto tets = thinner.Tetrahedra();
       if (st.rounds == 1 && st.tetrahedra == 0) st.tetrahedra = tets.size();
-      size_t thinned = 0;
-      for (const auto& tet : tets) thinned += thinner.ThinTetrahedron(tet) ? 1 : 0;
+      const size_t thinned = thinner.ThinPass(tets);
       st.tetrahedra_thinned += thinned;
       monitor.Info("round " + std::to_string(st.rounds) + ": " + Count(tets.size(), "closed tetrahedra, ") +
                    Count(thinned, "thinned (2 faces removed from each)"));

@@ -1,0 +1,229 @@
+// build-gvd: the geodesic labelling against closed-form geodesics, the graph pruning, the dual triangles,
+// determinism across thread counts, and the executable's handling of bad input.
+#include <gtest/gtest.h>
+#include <omp.h>
+
+#include <cmath>
+#include <set>
+
+#include "common/errors.h"
+#include "common/mesh_topology.h"
+#include "common/shapes.h"
+#include "formats/labels_io.h"
+#include "formats/mesh_io.h"
+#include "stages/build-gvd/build_gvd.h"
+#include "stages/sample-seeds/sample_seeds.h"
+#include "tests/support/test_support.h"
+
+namespace voroudf {
+namespace {
+
+using test::RunProgram;
+using test::TempDir;
+
+SeedCloud Seeds(const Udf& udf, size_t count, uint64_t seed = 3) {
+  SampleSeedsOptions o;
+  o.count = count;
+  o.seed = seed;
+  return SampleSeeds(udf, o, Monitor::Null());
+}
+
+double GreatCircle(const Vec3& a, const Vec3& b) {
+  const double c = std::clamp(a.normalized().dot(b.normalized()), -1.0, 1.0);
+  return 0.5 * std::acos(c);
+}
+
+TEST(BuildGvd, LabelsAreTheGeodesicallyNearestSeedOnTheSphere) {
+  const auto udf = MakeShape("sphere");
+  const SeedCloud seeds = Seeds(*udf, 60);
+  const GvdResult r = BuildGvd(*udf, seeds, BuildGvdOptions{}, false, Monitor::Null());
+  ASSERT_GT(r.samples.size(), 60u * 50u);
+  EXPECT_EQ(r.stats.unreached, 0u);
+  size_t agree = 0, close_calls = 0;
+  double worst_ratio = 0;
+  for (size_t s = 0; s < r.samples.size(); ++s) {
+    const Vec3& p = r.samples.position[s];
+    const int l = r.samples.label[s];
+    ASSERT_GE(l, 0);
+    // The true geodesic Voronoi label (great circles); ties within 3% are not held against the graph.
+    double best = INFINITY, second = INFINITY;
+    int best_i = -1;
+    for (size_t i = 0; i < seeds.size(); ++i) {
+      const double g = GreatCircle(p, seeds.position[i]);
+      if (g < best) {
+        second = best;
+        best = g;
+        best_i = static_cast<int>(i);
+      } else if (g < second) {
+        second = g;
+      }
+    }
+    if (second - best < 0.03 * best) {
+      ++close_calls;
+      continue;
+    }
+    agree += (l == best_i) ? 1 : 0;
+    // The graph distance is a path through samples: never shorter than the geodesic, and not much longer.
+    const double g = GreatCircle(p, seeds.position[static_cast<size_t>(l)]);
+    if (g > 0.1) worst_ratio = std::max(worst_ratio, r.samples.dist[s] / g);
+    EXPECT_GE(r.samples.dist[s], 0.99 * g - 1e-6);  // chords are a little shorter than arcs
+  }
+  const size_t judged = r.samples.size() - close_calls;
+  EXPECT_GT(static_cast<double>(agree), 0.99 * static_cast<double>(judged));
+  EXPECT_LT(worst_ratio, 1.4);  // zigzag of a sparse (6k samples) kNN graph
+}
+
+TEST(BuildGvd, SeedsLabelThemselvesAndTheDualOfFewSeedsOnASphereIsClosed) {
+  const auto udf = MakeShape("sphere");
+  const SeedCloud seeds = Seeds(*udf, 200);
+  const GvdResult r = BuildGvd(*udf, seeds, BuildGvdOptions{}, true, Monitor::Null());
+  size_t seed_nodes = 0;
+  for (size_t s = 0; s < r.samples.size(); ++s)
+    for (size_t i = 0; i < seeds.size(); ++i)
+      if (r.samples.position[s] == seeds.position[i]) {
+        ++seed_nodes;
+        EXPECT_EQ(r.samples.label[s], static_cast<int>(i));
+        EXPECT_EQ(r.samples.dist[s], 0.0);
+      }
+  EXPECT_EQ(seed_nodes, seeds.size());
+  EXPECT_EQ(r.thick.vertices.size(), seeds.size());
+  // Every dual triangle joins three distinct seeds and appears once.
+  std::set<Tri> unique(r.thick.faces.begin(), r.thick.faces.end());
+  EXPECT_EQ(unique.size(), r.thick.faces.size());
+  for (const Tri& t : r.thick.faces) EXPECT_TRUE(t[0] < t[1] && t[1] < t[2]);
+  // Every pruned edge in the graph passes both tests.
+  const double eps = BuildGvdOptions{}.eps_udf_rel * udf->Domain().Diagonal();
+  ASSERT_FALSE(r.samples.edges.empty());
+  for (size_t e = 0; e < r.samples.edges.size(); e += 97) {
+    const Vec3 a = r.samples.position[static_cast<size_t>(r.samples.edges[e][0])];
+    const Vec3 b = r.samples.position[static_cast<size_t>(r.samples.edges[e][1])];
+    EXPECT_LE(udf->Distance(0.5 * (a + b)), eps);
+  }
+}
+
+TEST(BuildGvd, TheGraphDoesNotJumpBetweenSheetsAwayFromTheirIntersection) {
+  // Crossing planes z = 0 and x = 0: a kept edge joins the two planes only near the line x = z = 0.
+  const auto udf = MakeShape("crossing-planes");
+  const SeedCloud seeds = Seeds(*udf, 300);
+  const GvdResult r = BuildGvd(*udf, seeds, BuildGvdOptions{}, true, Monitor::Null());
+  size_t across = 0;
+  for (const auto& e : r.samples.edges) {
+    const Vec3& a = r.samples.position[static_cast<size_t>(e[0])];
+    const Vec3& b = r.samples.position[static_cast<size_t>(e[1])];
+    const bool a_z = std::abs(a.z()) < 1e-6, b_z = std::abs(b.z()) < 1e-6;
+    const bool a_x = std::abs(a.x()) < 1e-6, b_x = std::abs(b.x()) < 1e-6;
+    if ((a_z && !a_x && b_x && !b_z) || (a_x && !a_z && b_z && !b_x)) {
+      ++across;
+      // Both ends within twice the UDF threshold of the line.
+      const double eps = BuildGvdOptions{}.eps_udf_rel * udf->Domain().Diagonal();
+      EXPECT_LT(std::min(std::hypot(a.x(), a.z()), std::hypot(b.x(), b.z())), 2.0 * eps + 1e-9);
+    }
+  }
+  EXPECT_GT(across, 0u) << "the sheets must connect across the non-manifold line";
+}
+
+TEST(BuildGvd, OverPrunedGraphsLeaveUnreachedSamplesCounted) {
+  const auto udf = MakeShape("sphere");
+  const SeedCloud seeds = Seeds(*udf, 100);
+  BuildGvdOptions o;
+  o.eps_udf_rel = 1e-9;  // every edge between distinct points of the curved sphere bends off it by more
+  EXPECT_THROW(BuildGvd(*udf, seeds, o, false, Monitor::Null()), NumericalError);
+  o.eps_udf_rel = 5e-5;  // only the shortest edges survive: some samples are cut off from every seed
+  const GvdResult r = BuildGvd(*udf, seeds, o, false, Monitor::Null());
+  size_t minus_one = 0;
+  for (size_t s = 0; s < r.samples.size(); ++s)
+    if (r.samples.label[s] < 0) {
+      ++minus_one;
+      EXPECT_EQ(r.samples.dist[s], -1.0);
+    }
+  EXPECT_EQ(minus_one, r.stats.unreached);
+  EXPECT_GT(r.stats.edges_pruned_udf, 0u);
+}
+
+TEST(BuildGvd, SameResultWhateverTheThreadCount) {
+  const auto udf = MakeShape("three-discs");
+  const SeedCloud seeds = Seeds(*udf, 300);
+  const int threads = omp_get_max_threads();
+  omp_set_num_threads(1);
+  const GvdResult one = BuildGvd(*udf, seeds, BuildGvdOptions{}, true, Monitor::Null());
+  omp_set_num_threads(std::max(2, threads));
+  const GvdResult many = BuildGvd(*udf, seeds, BuildGvdOptions{}, true, Monitor::Null());
+  omp_set_num_threads(threads);
+  EXPECT_EQ(one.thick.faces, many.thick.faces);
+  EXPECT_EQ(one.samples.position, many.samples.position);
+  EXPECT_EQ(one.samples.label, many.samples.label);
+  EXPECT_EQ(one.samples.dist, many.samples.dist);
+  EXPECT_EQ(one.samples.edges, many.samples.edges);
+}
+
+TEST(BuildGvd, BadOptionsAndEmptySeedsAreRefused) {
+  BuildGvdOptions o;
+  o.knn = 1;
+  EXPECT_THROW(o.Check(), UsageError);
+  o = BuildGvdOptions{};
+  o.eps_grad = 0;
+  EXPECT_THROW(o.Check(), UsageError);
+  const auto udf = MakeShape("sphere");
+  EXPECT_THROW(BuildGvd(*udf, SeedCloud{}, BuildGvdOptions{}, false, Monitor::Null()), InputError);
+}
+
+TEST(MortonCode, InterleavesTheAxes) {
+  Box box{Vec3(0, 0, 0), Vec3(1, 1, 1)};
+  EXPECT_EQ(MortonCode(Vec3(0, 0, 0), box), 0u);
+  EXPECT_EQ(MortonCode(Vec3(1, 1, 1), box), (1ull << 63) - 1);
+  EXPECT_LT(MortonCode(Vec3(0.49, 0.49, 0.49), box), MortonCode(Vec3(0.51, 0.0, 0.0), box));
+  EXPECT_EQ(MortonCode(Vec3(0.5, 0, 0), box), 1ull << 60);
+}
+
+class BuildGvdExe : public ::testing::Test {
+ protected:
+  TempDir dir_;
+};
+
+TEST_F(BuildGvdExe, WritesTheThickMeshLabelsAndGraphDeterministically) {
+  ASSERT_EQ(RunProgram("sample-seeds", {"--udf", "shape:sphere", "--count", "150", "-o", dir_ / "seeds.ply"}).exit_code, 0);
+  for (const char* threads : {"1", "2"}) {
+    const auto r = RunProgram("build-gvd", {"--udf", "shape:sphere", "-i", dir_ / "seeds.ply", "-o",
+                                            dir_ / (std::string("thick") + threads + ".ply"), "--labels",
+                                            dir_ / (std::string("labels") + threads + ".ply"), "--graph",
+                                            "--threads", threads});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_TRUE(r.out.empty());
+  }
+  EXPECT_EQ(test::ReadBytes(dir_ / "thick1.ply"), test::ReadBytes(dir_ / "thick2.ply"));
+  EXPECT_EQ(test::ReadBytes(dir_ / "labels1.ply"), test::ReadBytes(dir_ / "labels2.ply"));
+  const TriangleMesh thick = ReadMeshPly(dir_ / "thick1.ply");
+  EXPECT_EQ(thick.vertices.size(), 150u);
+  EXPECT_GT(thick.faces.size(), 250u);
+  const LabeledSamples labels = ReadLabels(dir_ / "labels1.ply");
+  EXPECT_GT(labels.size(), 150u * 50u);
+  EXPECT_FALSE(labels.edges.empty());
+}
+
+TEST_F(BuildGvdExe, BadInputExitsThreeAndWritesNothing) {
+  // A seeds file with no seeds.
+  test::WriteBytes(dir_ / "empty.ply",
+                   "ply\nformat ascii 1.0\ncomment voroudf seeds 1\nelement vertex 0\nproperty float x\n"
+                   "property float y\nproperty float z\nend_header\n");
+  auto r = RunProgram("build-gvd", {"--udf", "shape:sphere", "-i", dir_ / "empty.ply", "-o", dir_ / "thick.ply",
+                                    "--labels", dir_ / "labels.ply"});
+  EXPECT_EQ(r.exit_code, 3) << r.err;
+  EXPECT_NE(r.err.find("build-gvd: error:"), std::string::npos);
+  // A mesh given as seeds.
+  TriangleMesh m;
+  m.vertices = {{0, 0, 0}, {0.1, 0, 0}, {0, 0.1, 0}};
+  m.faces = {{0, 1, 2}};
+  WriteMeshPly(dir_ / "mesh.ply", m, Provenance{"test", "", ""});
+  r = RunProgram("build-gvd", {"--udf", "shape:sphere", "-i", dir_ / "mesh.ply", "-o", dir_ / "thick.ply"});
+  EXPECT_EQ(r.exit_code, 3) << r.err;
+  // Unknown dual rule: a usage error.
+  r = RunProgram("build-gvd", {"--udf", "shape:sphere", "-i", dir_ / "empty.ply", "-o", dir_ / "thick.ply",
+                               "--dual-rule", "nope"});
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_FALSE(test::Exists(dir_ / "thick.ply"));
+  EXPECT_FALSE(test::Exists(dir_ / "labels.ply"));
+  EXPECT_EQ(dir_.List().size(), 2u);
+}
+
+}  // namespace
+}  // namespace voroudf
