@@ -131,6 +131,10 @@ TEST_F(FakeServers, EveryMisbehaviourIsAnInputErrorWithinTheTimeout) {
   ExpectInputError(Script("version.py", "import struct, sys\nsys.stdout.buffer.write(b'VUDF' + struct.pack('<I', 9) + bytes(40))\n"
                                         "sys.stdout.flush()\n"),
                    "version 9");
+  // Closes its stdin and stays: our write gets EPIPE (SIGPIPE must not kill the program).
+  // (stdin closed before the handshake, so it is closed by the time we write)
+  ExpectInputError("exec " + Script("closed.py", "import os\nos.close(0)\n" + FakeServer("time.sleep(60)\n")),
+                   "closed its stdin");
   ExpectInputError("/nonexistent/udf-server", "exited with status 127");
   ExpectInputError("", "no command");
 }
