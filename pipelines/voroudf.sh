@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# The whole chain for one shape; every intermediate file is kept in DIR so each stage can be inspected.
+# The whole chain for one shape (sample-seeds -> optimize-seeds -> build-gvd -> thin-mesh); every intermediate
+# file is kept in DIR so each stage can be inspected.
 # Usage: pipelines/voroudf.sh --udf SPEC -o DIR [--count N] [--seed S] [--threads T]
 set -euo pipefail
 ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
@@ -23,3 +24,14 @@ mkdir -p "$OUT"
 
 run() { echo "+ $*" >&2; "$@"; }
 run "$BIN/sample-seeds" --udf "$UDF" --count "$COUNT" --seed "$SEED" --threads "$THREADS" -o "$OUT/seeds0.ply"
+if [ -x "$BIN/optimize-seeds" ]; then
+  run "$BIN/optimize-seeds" --udf "$UDF" --seed "$SEED" --threads "$THREADS" -i "$OUT/seeds0.ply" -o "$OUT/seeds.ply"
+else
+  echo "$0: warning: $BIN/optimize-seeds not found; meshing the unoptimised seeds" >&2
+  cp "$OUT/seeds0.ply" "$OUT/seeds.ply"
+fi
+run "$BIN/build-gvd" --udf "$UDF" --seed "$SEED" --threads "$THREADS" -i "$OUT/seeds.ply" -o "$OUT/thick.ply" \
+  --labels "$OUT/labels.ply"
+run "$BIN/thin-mesh" --udf "$UDF" --threads "$THREADS" -i "$OUT/thick.ply" -o "$OUT/mesh.ply" \
+  --nm-edges "$OUT/nm-edges.ply"
+echo "mesh: $OUT/mesh.ply (non-manifold edges: $OUT/nm-edges.ply; Voronoi labels: $OUT/labels.ply)" >&2
