@@ -42,8 +42,10 @@ std::unique_ptr<MeshUdf> MeshUdf::Open(const std::string& path, const MeshUdfOpt
 }
 
 void MeshUdf::EvaluateChunk(const Vec3* points, size_t count, double* distance, Vec3* gradient) const {
+  int hint = -1;  // consecutive points of a batch are often close (Morton order): start from the last hit
   for (size_t i = 0; i < count; ++i) {
-    const TriangleBvh::Hit hit = bvh_->Closest(points[i]);
+    const TriangleBvh::Hit hit = bvh_->Closest(points[i], hint);
+    hint = hit.slot;
     if (hit.face < 0) {  // non-finite query: every comparison failed
       distance[i] = std::numeric_limits<double>::quiet_NaN();
       gradient[i] = Vec3::Zero();

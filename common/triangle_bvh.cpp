@@ -126,6 +126,10 @@ TriangleBvh::TriangleBvh(const std::vector<Vec3>& vertices, const std::vector<Tr
       }
     }
   }
+  // Rounding in a computed distance is a few ulps of the coordinates' magnitude; 1e-12 of it is far above.
+  double magnitude = 0.0;
+  for (const Eigen::AlignedBox3d& b : box) magnitude = std::max({magnitude, b.min().cwiseAbs().maxCoeff(), b.max().cwiseAbs().maxCoeff()});
+  tie_slack_ = 1e-12 * magnitude;
   std::vector<int> order(n);
   for (int f = 0; f < n; ++f) order[f] = f;
   nodes_.reserve(2 * static_cast<size_t>(n));
@@ -255,37 +259,52 @@ inline double BoxSqDistance(const float* lo, const float* hi, double px, double 
 
 }  // namespace
 
-TriangleBvh::Hit TriangleBvh::Closest(const Vec3& p) const {
+TriangleBvh::Hit TriangleBvh::Closest(const Vec3& p, int hint) const {
   const double px = p.x(), py = p.y(), pz = p.z();
   double best = std::numeric_limits<double>::infinity();
+  // Boxes and planes are pruned only beyond `bound` = (sqrt(best) + tie_slack_)^2, so that every triangle
+  // whose distance could round to a tie with the best is examined: the result is then the minimum of
+  // (squared distance, slot) over all triangles, independent of the traversal's starting bound.
+  double bound = best;
   double bx = 0, by = 0, bz = 0;
   int best_slot = -1;
 
+  auto test_triangle = [&](int s) {
+    const PackedTri& t = tris_[s];
+    const double apx = px - t.a[0], apy = py - t.a[1], apz = pz - t.a[2];
+    // The distance to the triangle's plane bounds the distance from below: many triangles of a
+    // visited leaf are rejected by it without the region tests.
+    const double plane = apx * t.n[0] + apy * t.n[1] + apz * t.n[2];
+    if (plane * plane > bound) return;
+    double qx, qy, qz;
+    if (t.inv_det != 0.0) {
+      const double d1 = t.ab[0] * apx + t.ab[1] * apy + t.ab[2] * apz;
+      const double d2 = t.ac[0] * apx + t.ac[1] * apy + t.ac[2] * apz;
+      double v, w;
+      EricsonBarycentric(d1, d2, t.d00, t.d01, t.d11, t.inv_det, &v, &w);
+      qx = t.a[0] + v * t.ab[0] + w * t.ac[0];
+      qy = t.a[1] + v * t.ab[1] + w * t.ac[1];
+      qz = t.a[2] + v * t.ab[2] + w * t.ac[2];
+    } else {
+      const Vec3 a(t.a[0], t.a[1], t.a[2]);
+      const Vec3 q = ClosestOnEdges(p, a, a + Vec3(t.ab[0], t.ab[1], t.ab[2]), a + Vec3(t.ac[0], t.ac[1], t.ac[2]));
+      qx = q.x(), qy = q.y(), qz = q.z();
+    }
+    const double dx = px - qx, dy = py - qy, dz = pz - qz;
+    const double sq = dx * dx + dy * dy + dz * dz;
+    if (sq < best || (sq == best && s < best_slot)) {
+      if (sq < best) {
+        const double r = std::sqrt(sq) + tie_slack_;
+        bound = r * r;
+      }
+      best = sq, bx = qx, by = qy, bz = qz, best_slot = s;
+    }
+  };
+  if (hint >= 0 && hint < static_cast<int>(tris_.size())) test_triangle(hint);
+
   auto test_leaf = [&](int first, int count) {
     for (int s = first, e = first + count; s < e; ++s) {
-      const PackedTri& t = tris_[s];
-      const double apx = px - t.a[0], apy = py - t.a[1], apz = pz - t.a[2];
-      // The distance to the triangle's plane bounds the distance from below: most triangles of a
-      // visited leaf are rejected by it without the region tests.
-      const double plane = apx * t.n[0] + apy * t.n[1] + apz * t.n[2];
-      if (plane * plane >= best) continue;
-      double qx, qy, qz;
-      if (t.inv_det != 0.0) {
-        const double d1 = t.ab[0] * apx + t.ab[1] * apy + t.ab[2] * apz;
-        const double d2 = t.ac[0] * apx + t.ac[1] * apy + t.ac[2] * apz;
-        double v, w;
-        EricsonBarycentric(d1, d2, t.d00, t.d01, t.d11, t.inv_det, &v, &w);
-        qx = t.a[0] + v * t.ab[0] + w * t.ac[0];
-        qy = t.a[1] + v * t.ab[1] + w * t.ac[1];
-        qz = t.a[2] + v * t.ab[2] + w * t.ac[2];
-      } else {
-        const Vec3 a(t.a[0], t.a[1], t.a[2]);
-        const Vec3 q = ClosestOnEdges(p, a, a + Vec3(t.ab[0], t.ab[1], t.ab[2]), a + Vec3(t.ac[0], t.ac[1], t.ac[2]));
-        qx = q.x(), qy = q.y(), qz = q.z();
-      }
-      const double dx = px - qx, dy = py - qy, dz = pz - qz;
-      const double sq = dx * dx + dy * dy + dz * dz;
-      if (sq < best) best = sq, bx = qx, by = qy, bz = qz, best_slot = s;
+      test_triangle(s);
     }
   };
 
@@ -304,14 +323,14 @@ TriangleBvh::Hit TriangleBvh::Closest(const Vec3& p) const {
     const double dnear = nc ? d1 : d0, dfar = nc ? d0 : d1;
     const int near_index = nd.child[nc], near_count = nd.count[nc];
     const int far_index = nd.child[1 - nc], far_count = nd.count[1 - nc];
-    if (dnear < best) {
+    if (dnear <= bound) {
       if (near_count == 0) {
-        if (dfar < best) stack[top++] = {far_index, far_count, dfar};
+        if (dfar <= bound) stack[top++] = {far_index, far_count, dfar};
         node = near_index;
         continue;
       }
       test_leaf(near_index, near_count);
-      if (dfar < best) {
+      if (dfar <= bound) {
         if (far_count == 0) {
           node = far_index;
           continue;
@@ -323,7 +342,7 @@ TriangleBvh::Hit TriangleBvh::Closest(const Vec3& p) const {
     node = -1;
     while (top > 0) {
       const Entry e = stack[--top];
-      if (!(e.sq < best)) continue;
+      if (!(e.sq <= bound)) continue;
       if (e.count > 0) {
         test_leaf(e.index, e.count);
         continue;
@@ -337,6 +356,7 @@ TriangleBvh::Hit TriangleBvh::Closest(const Vec3& p) const {
   hit.sq_distance = best;
   hit.point = Vec3(bx, by, bz);
   hit.face = best_slot >= 0 ? face_of_[best_slot] : -1;
+  hit.slot = best_slot;
   return hit;
 }
 

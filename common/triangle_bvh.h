@@ -29,6 +29,7 @@ class TriangleBvh {
     double sq_distance = 0.0;  ///< squared distance from the query to `point`
     Vec3 point;                ///< the closest point on the triangle set
     int face = -1;             ///< index of its triangle in the faces given to the constructor
+    int slot = -1;             ///< its place in the BVH: pass it as the hint of a nearby query
   };
 
   /// Builds the hierarchy over every face (degenerate ones included; faces are not welded or deduplicated:
@@ -36,10 +37,14 @@ class TriangleBvh {
   /// \pre faces is non-empty and every index is a valid vertex; vertices are finite.
   TriangleBvh(const std::vector<Vec3>& vertices, const std::vector<Tri>& faces);
 
-  /// The closest point to p over all triangles. On exact ties (medial axis) the first triangle met in
-  /// the traversal wins; the traversal order depends only on p, so the answer is deterministic.
+  /// The closest point to p over all triangles. Ties (the medial axis) go to the triangle with the
+  /// smallest slot: the answer is the minimum of (squared distance, slot), whatever the hint.
+  /// \param hint the slot of a previous nearby query's hit (or -1): testing that triangle first gives a
+  ///        tight bound at once, which prunes most of the traversal for spatially coherent queries. Every
+  ///        triangle within kTieSlack of the running bound is still examined, so the hint changes the
+  ///        cost, never the result.
   /// Thread-safe (const, no shared mutable state).
-  Hit Closest(const Vec3& p) const;
+  Hit Closest(const Vec3& p, int hint = -1) const;
 
   /// Unit normal of face `face` (original index); for a degenerate face a deterministic unit vector
   /// orthogonal to its longest edge (or +z if all three corners coincide).
@@ -80,6 +85,7 @@ class TriangleBvh {
   std::vector<int> face_of_;   // leaf-order slot -> original face index
   std::vector<Vec3> normal_;   // per original face
   size_t num_degenerate_ = 0;
+  double tie_slack_ = 0.0;  // lengths this much above the best are still examined (rounding of bounds)
   int depth_ = 0;
 };
 

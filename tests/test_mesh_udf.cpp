@@ -155,6 +155,35 @@ TEST(MeshUdf, MatchesBruteForceOnClosedOpenNonManifoldAndDegenerateMeshes) {
   ExpectMatchesBruteForce(RandomSoup(2000, 3), "random soup");
 }
 
+TEST(MeshUdf, ResultsDoNotDependOnBatchOrderOrTheTraversalHint) {
+  // Large batches run in Morton order with each query starting from the previous hit; single queries
+  // start from nothing. Medial-axis points (exact ties between faces) and on-surface points included.
+  for (const TriangleMesh& mesh : {Octahedron(), Book(), RandomSoup(500, 8), WithDegenerates()}) {
+    const MeshUdf udf(mesh, "m");
+    std::vector<Vec3> pts = QueryPoints(udf, 6000, 12);
+    for (int i = -10; i <= 10; ++i) {
+      const double t = 0.05 * i;
+      pts.insert(pts.end(), {Vec3(0, 0, t), Vec3(t, 0, 0), Vec3(0, t, 0), Vec3(t, t, 0), Vec3(t, t, t), Vec3(0, t, -t)});
+    }
+    pts.insert(pts.end(), mesh.vertices.begin(), mesh.vertices.end());
+    std::vector<double> d;
+    std::vector<Vec3> g;
+    udf.Evaluate(pts, d, g);
+    std::vector<Vec3> reversed(pts.rbegin(), pts.rend());
+    std::vector<double> dr(pts.size());
+    std::vector<Vec3> gr(pts.size());
+    udf.EvaluateChunk(reversed.data(), reversed.size(), dr.data(), gr.data());
+    for (size_t i = 0; i < pts.size(); ++i) {
+      Vec3 g1;
+      const double d1 = udf.Distance(pts[i], &g1);
+      ASSERT_EQ(d[i], d1) << i << " " << pts[i].transpose();
+      ASSERT_EQ(g[i], g1) << i << " " << pts[i].transpose();
+      ASSERT_EQ(dr[pts.size() - 1 - i], d1) << i;
+      ASSERT_EQ(gr[pts.size() - 1 - i], g1) << i;
+    }
+  }
+}
+
 TEST(MeshUdf, ClosestPointOnTriangleHandlesEveryRegionAndDegenerateInput) {
   const Vec3 a(0, 0, 0), b(1, 0, 0), c(0, 1, 0);
   EXPECT_TRUE(ClosestPointOnTriangle(Vec3(0.2, 0.2, 1), a, b, c).isApprox(Vec3(0.2, 0.2, 0)));
