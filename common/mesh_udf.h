@@ -26,8 +26,8 @@ struct MeshUdfOptions {
 /// surface, where the UDF has a kink) it is the unit normal of the closest triangle, oriented towards x
 /// when that side can be told (n.(x - c) >= 0), else as stored; a degenerate triangle's normal is a
 /// deterministic unit vector orthogonal to its longest edge. On the medial axis: the direction to the
-/// closest point of the first triangle met by the (point-determined) traversal. A non-finite query gets
-/// a NaN distance and a zero gradient.
+/// closest point of the tied triangle that comes first in the BVH's leaf order — the same whatever the
+/// batch, its order or the thread count (tested). A non-finite query gets a NaN distance and a zero gradient.
 ///
 /// Thread-safe; EvaluateChunk costs one BVH query per point (see tests/bench/bench_udf.cpp).
 class MeshUdf : public Udf {
