@@ -6,9 +6,23 @@
 
 namespace voroudf {
 
+void L1TangentProblem::AddTerm(const Vec3& a_m, double b_m, double tolerance) {
+  if (w.size() < a.size()) w.resize(a.size(), 1.0);
+  for (size_t k = 0; k < a.size(); ++k) {
+    if (std::abs(b[k] - b_m) <= tolerance && (a[k] - a_m).lpNorm<Eigen::Infinity>() <= tolerance) {
+      w[k] += 1.0;
+      return;
+    }
+  }
+  a.push_back(a_m);
+  b.push_back(b_m);
+  w.push_back(1.0);
+}
+
 double L1TangentObjective(const L1TangentProblem& problem, const Vec3& y) {
   double sum = 0.0;
-  for (size_t m = 0; m < problem.a.size(); ++m) sum += std::abs(problem.a[m].dot(y) - problem.b[m]);
+  for (size_t m = 0; m < problem.a.size(); ++m)
+    sum += (problem.w.empty() ? 1.0 : problem.w[m]) * std::abs(problem.a[m].dot(y) - problem.b[m]);
   return sum + problem.gamma * y.squaredNorm();
 }
 
@@ -26,7 +40,7 @@ double FeasibleScale(const L1TangentProblem& p, const Vec3& y) {
 
 }  // namespace
 
-L1TangentSolution SolveL1Tangent(const L1TangentProblem& p, const L1TangentOptions& options) {
+L1TangentSolution SolveL1TangentByCoordinateAscent(const L1TangentProblem& p, const L1TangentOptions& options) {
   const size_t m_count = p.a.size();
   const size_t k_count = p.c.size();
   const double two_gamma = 2.0 * p.gamma;
@@ -42,7 +56,8 @@ L1TangentSolution SolveL1Tangent(const L1TangentProblem& p, const L1TangentOptio
       const double aa = p.a[m].squaredNorm();
       if (aa == 0.0) continue;
       // dD/du_m = −a_mᵀw/(2γ) − b_m; curvature −‖a_m‖²/(2γ): the exact 1-D maximiser, clipped.
-      const double target = std::clamp(u[m] + options.relaxation * (-p.a[m].dot(w) - two_gamma * p.b[m]) / aa, -1.0, 1.0);
+      const double bound = p.w.empty() ? 1.0 : p.w[m];
+      const double target = std::clamp(u[m] + options.relaxation * (-p.a[m].dot(w) - two_gamma * p.b[m]) / aa, -bound, bound);
       const double step = target - u[m];
       if (step == 0.0) continue;
       u[m] = target;
@@ -79,6 +94,156 @@ L1TangentSolution SolveL1Tangent(const L1TangentProblem& p, const L1TangentOptio
       best.converged = true;
       break;
     }
+  }
+  return best;
+}
+
+double L1TangentDual(const L1TangentProblem& p, const std::vector<double>& u, const std::vector<double>& lambda) {
+  Vec3 w = Vec3::Zero();
+  double linear = 0.0;
+  for (size_t m = 0; m < p.a.size(); ++m) {
+    w += u[m] * p.a[m];
+    linear += u[m] * p.b[m];
+  }
+  for (size_t k = 0; k < p.c.size(); ++k) {
+    w += lambda[k] * p.c[k];
+    linear += lambda[k] * p.h[k];
+  }
+  return -w.squaredNorm() / (4.0 * p.gamma) - linear;
+}
+
+// Cyclic coordinate ascent sweeps on D from (u, λ) (each coordinate's exact 1-D maximiser, clipped to its
+// interval); D never decreases. Returns D at the end.
+double AscendDual(const L1TangentProblem& p, std::vector<double>& u, std::vector<double>& lambda, int sweeps) {
+  const double two_gamma = 2.0 * p.gamma;
+  Vec3 w = Vec3::Zero();
+  for (size_t m = 0; m < p.a.size(); ++m) w += u[m] * p.a[m];
+  for (size_t k = 0; k < p.c.size(); ++k) w += lambda[k] * p.c[k];
+  for (int sweep = 0; sweep < sweeps; ++sweep) {
+    for (size_t m = 0; m < p.a.size(); ++m) {
+      const double bound = p.w.empty() ? 1.0 : p.w[m];
+      const double target = std::clamp(u[m] + (-p.a[m].dot(w) - two_gamma * p.b[m]) / p.a[m].squaredNorm(), -bound, bound);
+      w += (target - u[m]) * p.a[m];
+      u[m] = target;
+    }
+    for (size_t k = 0; k < p.c.size(); ++k) {
+      const double target = std::max(0.0, lambda[k] + (-p.c[k].dot(w) - two_gamma * p.h[k]) / p.c[k].squaredNorm());
+      w += (target - lambda[k]) * p.c[k];
+      lambda[k] = target;
+    }
+  }
+  return L1TangentDual(p, u, lambda);
+}
+
+L1TangentSolution SolveL1Tangent(const L1TangentProblem& p, const L1TangentOptions& options) {
+  // Primal barrier method on  min Σ w_m t_m + γ‖y‖²  s.t.  −t_m ≤ a_mᵀy − b_m ≤ t_m,  c_kᵀy ≤ h_k.
+  // Newton's system in (y, t) has a diagonal t-block, so eliminating t leaves a 3×3 system: every Newton
+  // step costs O(M + K). The central path's multipliers give a dual point; the gap certifies the result.
+  const size_t m_count = p.a.size(), k_count = p.c.size();
+  auto weight = [&](size_t m) { return p.w.empty() ? 1.0 : p.w[m]; };
+  L1TangentSolution best;
+  best.primal = L1TangentObjective(p, Vec3::Zero());
+  best.dual = 0.0;  // D(0, 0) = 0
+  if (best.primal - best.dual <= options.gap_tolerance) {
+    best.converged = true;
+    return best;
+  }
+  const double barrier_terms = static_cast<double>(2 * m_count + k_count);
+  Vec3 y = Vec3::Zero();
+  std::vector<double> t(m_count), r(m_count), dt(m_count);
+  for (size_t m = 0; m < m_count; ++m) t[m] = std::abs(p.a[m].dot(y) - p.b[m]) + best.primal / static_cast<double>(m_count) + 1e-12;
+  double tau = barrier_terms / best.primal;  // start where the barrier's gap bound equals P(0)
+  std::vector<double> u(m_count), lambda(k_count);
+
+  auto barrier = [&](const Vec3& yy, const std::vector<double>& tt, double* value) {
+    double f = p.gamma * yy.squaredNorm(), logs = 0.0;
+    for (size_t m = 0; m < m_count; ++m) {
+      const double rm = p.a[m].dot(yy) - p.b[m];
+      const double sp = tt[m] - rm, sm = tt[m] + rm;
+      if (!(sp > 0.0 && sm > 0.0)) return false;
+      f += weight(m) * tt[m];
+      logs += std::log(sp) + std::log(sm);
+    }
+    for (size_t k = 0; k < k_count; ++k) {
+      const double sk = p.h[k] - p.c[k].dot(yy);
+      if (!(sk > 0.0)) return false;
+      logs += std::log(sk);
+    }
+    *value = tau * f - logs;
+    return true;
+  };
+
+  int steps = 0;
+  for (int stage = 0; stage < 60 && steps < options.max_newton_steps; ++stage) {
+    // Centre for this τ by damped Newton (the Newton decrement is scale-free: stop below 1e-10, or when
+    // rounding leaves no step that decreases the barrier).
+    for (int stage_steps = 0; steps < options.max_newton_steps && stage_steps < 50; ++steps, ++stage_steps) {
+      Eigen::Matrix3d h = 2.0 * tau * p.gamma * Eigen::Matrix3d::Identity();
+      Vec3 gy = 2.0 * tau * p.gamma * y;
+      Vec3 rhs = Vec3::Zero();
+      std::vector<double>& gt = r;  // reuse: gradient in t
+      std::vector<double> e(m_count), d(m_count);
+      for (size_t m = 0; m < m_count; ++m) {
+        const double rm = p.a[m].dot(y) - p.b[m];
+        const double ip = 1.0 / (t[m] - rm), im = 1.0 / (t[m] + rm);
+        gt[m] = tau * weight(m) - ip - im;
+        gy += (ip - im) * p.a[m];
+        d[m] = ip * ip + im * im;
+        e[m] = -ip * ip + im * im;
+        // Schur complement of the t-block: (d − e²/d) a aᵀ = (4 ip² im² / d) a aᵀ.
+        h += (d[m] - e[m] * e[m] / d[m]) * (p.a[m] * p.a[m].transpose());
+        rhs += (e[m] / d[m]) * gt[m] * p.a[m];
+      }
+      for (size_t k = 0; k < k_count; ++k) {
+        const double ik = 1.0 / (p.h[k] - p.c[k].dot(y));
+        gy += ik * p.c[k];
+        h += (ik * ik) * (p.c[k] * p.c[k].transpose());
+      }
+      const Vec3 dy = h.ldlt().solve(-gy + rhs);
+      double decrement = -gy.dot(dy);
+      for (size_t m = 0; m < m_count; ++m) {
+        dt[m] = (-gt[m] - e[m] * p.a[m].dot(dy)) / d[m];
+        decrement -= gt[m] * dt[m];
+      }
+      if (!(decrement > 1e-10)) break;
+      double f0;
+      barrier(y, t, &f0);
+      double step = 1.0;
+      bool moved = false;
+      std::vector<double> t_new(m_count);
+      for (int back = 0; back < 60 && !moved; ++back, step *= 0.5) {
+        const Vec3 y_new = y + step * dy;
+        for (size_t m = 0; m < m_count; ++m) t_new[m] = t[m] + step * dt[m];
+        double f1;
+        if (barrier(y_new, t_new, &f1) && f1 <= f0 - 0.25 * step * decrement) {
+          y = y_new;
+          t.swap(t_new);
+          moved = true;
+        }
+      }
+      if (!moved) break;
+    }
+    // Certificate from the central path's multipliers: u_m = z⁺ − z⁻, λ_k = 1/(τ s_k).
+    for (size_t m = 0; m < m_count; ++m) {
+      const double rm = p.a[m].dot(y) - p.b[m];
+      u[m] = std::clamp(1.0 / (tau * (t[m] - rm)) - 1.0 / (tau * (t[m] + rm)), -weight(m), weight(m));
+    }
+    for (size_t k = 0; k < k_count; ++k) lambda[k] = 1.0 / (tau * (p.h[k] - p.c[k].dot(y)));
+    const double primal = L1TangentObjective(p, y);
+    // The multipliers are only as accurate as 1/(τ s) in floating point; a few ascent sweeps from them
+    // (D only increases) sharpen the bound once the barrier has found the right active set.
+    best.dual = std::max(best.dual, L1TangentDual(p, u, lambda));
+    if (primal - best.dual > options.gap_tolerance) best.dual = std::max(best.dual, AscendDual(p, u, lambda, 3));
+    if (primal <= best.primal) {
+      best.primal = primal;
+      best.y = y;
+    }
+    best.sweeps = steps;
+    if (best.primal - best.dual <= options.gap_tolerance) {
+      best.converged = true;
+      break;
+    }
+    tau *= 20.0;
   }
   return best;
 }

@@ -11,7 +11,7 @@ namespace voroudf {
 /// One seed's L1 tangent problem, written in coordinates centred on the seed's current position x⁰ and
 /// scaled by a length L (optimize-seeds uses the domain box diagonal):  y = (x − x⁰) / L.
 ///
-///   minimise  P(y) = Σ_m |a_mᵀ y − b_m| + γ ‖y‖²   subject to  c_kᵀ y ≤ h_k  (all k)
+///   minimise  P(y) = Σ_m w_m |a_mᵀ y − b_m| + γ ‖y‖²   subject to  c_kᵀ y ≤ h_k  (all k)
 ///
 /// For a sample p_m with UDF value d_m and gradient n_m: a_m = n_m, b_m = (n_mᵀ(p_m − x⁰) − d_m) / L, so
 /// |a_mᵀy − b_m| = |n_mᵀ(p_m − x) − d_m| / L, the paper's Eq. (energy_l1) term. The constraints are the
@@ -19,22 +19,27 @@ namespace voroudf {
 struct L1TangentProblem {
   std::vector<Vec3> a;      ///< sample gradients (unit vectors)
   std::vector<double> b;    ///< sample offsets (relative units)
+  std::vector<double> w;    ///< weight of each term (> 0; empty: all 1): w_m |a_mᵀy − b_m|
   std::vector<Vec3> c;      ///< constraint normals (unit vectors)
   std::vector<double> h;    ///< constraint offsets (> 0, relative units)
   double gamma = 10.0;      ///< proximity weight γ (> 0)
 
-  void Clear() { a.clear(); b.clear(); c.clear(); h.clear(); }
+  void Clear() { a.clear(); b.clear(); w.clear(); c.clear(); h.clear(); }
+
+  /// Adds the term w·|aᵀy − b|, merged into an existing term with the same plane (a and b within
+  /// `tolerance`): samples of one flat facet of a mesh all give the same tangent plane, and one dual
+  /// coordinate per plane instead of one per sample makes each sweep cheaper.
+  void AddTerm(const Vec3& a_m, double b_m, double tolerance = 1e-9);
 };
 
 struct L1TangentOptions {
   /// Stop once the duality gap P(y) − D(u, λ) ≤ gap_tolerance. Since P is 2γ-strongly convex,
   /// ‖y − y*‖ ≤ sqrt(gap / γ): set gap_tolerance = γ·ε² for a position error of ε (relative units).
   double gap_tolerance = 1e-11;
-  int max_sweeps = 2000;  ///< cyclic passes over the dual coordinates before giving up on the gap
-  /// Projected successive over-relaxation factor ω ∈ (0, 2): each coordinate moves ω times its exact 1-D
-  /// step (then clipped). ω = 1 is plain coordinate ascent; ω > 1 speeds it up on nearly parallel tangent
-  /// planes (a faceted curved surface), and projected SOR on a box-constrained concave QP still converges
-  /// for any ω in (0, 2) (Mangasarian 1977; Luo & Tseng 1992).
+  int max_newton_steps = 200;  ///< barrier method: Newton steps in total before giving up on the gap
+  int max_sweeps = 2000;       ///< coordinate ascent: cyclic passes over the dual coordinates
+  /// Coordinate ascent: projected successive over-relaxation factor ω ∈ (0, 2) (ω = 1: plain ascent);
+  /// projected SOR on a box-constrained concave QP converges for any ω in (0, 2) (Mangasarian 1977).
   double relaxation = 1.0;
 };
 
@@ -42,19 +47,32 @@ struct L1TangentSolution {
   Vec3 y = Vec3::Zero();  ///< feasible minimiser (within the gap tolerance)
   double primal = 0.0;    ///< P(y)
   double dual = 0.0;      ///< D(u, λ) ≤ P(y*) ≤ P(y)
-  int sweeps = 0;
+  int sweeps = 0;         ///< Newton steps (barrier) or sweeps (coordinate ascent)
   bool converged = false; ///< gap ≤ tolerance; if false, y is still feasible and P(y) ≤ P(0)
 };
 
-/// Solves the problem exactly up to a certified duality gap, by cyclic coordinate ascent on its dual
-///   max_{u ∈ [−1,1]^M, λ ≥ 0}  D(u, λ) = −‖Aᵀu + Cᵀλ‖² / (4γ) − uᵀb − λᵀh,   y(u, λ) = −(Aᵀu + Cᵀλ) / (2γ)
-/// (|r| = max_{|u|≤1} u r; the minimisation over y is closed-form because γ > 0). D is a concave quadratic
-/// over a product of intervals, so every coordinate update is a closed-form 1-D maximisation clipped to
-/// its interval, and cyclic coordinate ascent converges (Luo & Tseng 1992). The primal iterate y(u, λ) is
-/// pulled back towards 0 (strictly feasible) until it satisfies every constraint; the gap between its
-/// primal value and D certifies optimality. Falls back to y = 0 if that is better when not converged.
-/// \pre gamma > 0; every h_k > 0; a_m and c_k unit (or zero: then ignored).
+/// The Lagrangian dual of the problem:
+///   D(u, λ) = −‖Aᵀu + Cᵀλ‖² / (4γ) − uᵀb − λᵀh,   u_m ∈ [−w_m, w_m], λ ≥ 0,
+/// whose minimiser in y is y(u, λ) = −(Aᵀu + Cᵀλ)/(2γ) (|r| = max_{|u|≤1} u r; closed form since γ > 0).
+/// Every such (u, λ) gives a lower bound D ≤ min P: the certificate both solvers stop on.
+double L1TangentDual(const L1TangentProblem& problem, const std::vector<double>& u, const std::vector<double>& lambda);
+
+/// Solves the problem exactly up to a certified duality gap with a primal barrier (interior-point)
+/// method on the smooth equivalent  min Σ w_m t_m + γ‖y‖²  s.t.  −t_m ≤ a_mᵀy − b_m ≤ t_m,  c_kᵀy ≤ h_k
+/// (Boyd & Vandenberghe, Convex Optimization, Sec. 11.3): damped Newton centring, barrier weight ×20 per
+/// stage. Eliminating the t-block (diagonal) reduces every Newton system to 3×3, so a step costs O(M + K).
+/// After each stage the central path's multipliers u_m = z⁺_m − z⁻_m (clipped to [−w_m, w_m]) and
+/// λ_k = 1/(τ s_k) give a dual point; the stage's y is strictly feasible; the solver stops when
+/// P(y) − D(u, λ) ≤ gap_tolerance. It returns the best feasible y seen, never worse than y = 0.
+/// \pre gamma > 0; every h_k > 0; a_m and c_k unit vectors.
 L1TangentSolution SolveL1Tangent(const L1TangentProblem& problem, const L1TangentOptions& options);
+
+/// The same problem by cyclic coordinate ascent on D (each update a closed-form 1-D maximisation clipped
+/// to its interval; converges for a concave quadratic over a box, Luo & Tseng 1992), with the primal
+/// iterate y(u, λ) pulled back towards 0 until feasible for the gap. Simple and exact on orthogonal
+/// planes, but slow on nearly parallel ones (curved or finely faceted surfaces); kept as an independent
+/// cross-check of SolveL1Tangent in the tests.
+L1TangentSolution SolveL1TangentByCoordinateAscent(const L1TangentProblem& problem, const L1TangentOptions& options);
 
 /// P(y) without the constraints (for tests and logs).
 double L1TangentObjective(const L1TangentProblem& problem, const Vec3& y);

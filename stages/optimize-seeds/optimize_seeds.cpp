@@ -29,8 +29,7 @@ void OptimizeSeedsOptions::Check() const {
   if (!(sigma_max_spacing >= 0.0 && sigma_max_spacing <= 10.0)) throw UsageError("--sigma-max-spacing must be in [0, 10]");
   if (!(repulsion_cutoff >= 1.0 && repulsion_cutoff <= 10.0)) throw UsageError("--repulsion-cutoff must be in [1, 10]");
   if (!(l1_tol_rel > 0.0 && l1_tol_rel < 0.1)) throw UsageError("--l1-tol-rel must be in (0, 0.1)");
-  if (!(l1_relaxation > 0.0 && l1_relaxation < 2.0)) throw UsageError("--l1-relaxation must be in (0, 2)");
-  if (l1_max_sweeps < 1) throw UsageError("--l1-max-sweeps must be at least 1");
+  if (l1_max_steps < 1) throw UsageError("--l1-max-steps must be at least 1");
   if (!(move_tol >= 0.0 && move_tol < 1.0)) throw UsageError("--move-tol must be in [0, 1)");
   if (!(proj_tol_rel > 0.0 && proj_tol_rel < 0.1)) throw UsageError("--proj-tol-rel must be in (0, 0.1)");
   if (proj_max_iters < 1) throw UsageError("--proj-max-iters must be at least 1");
@@ -166,8 +165,7 @@ class Optimizer {
     L1TangentOptions solver;
     // Lengths relative to the diagonal: ‖y − y*‖ ≤ sqrt(gap/γ) ≤ l1_tol_rel.
     solver.gap_tolerance = options_.gamma * options_.l1_tol_rel * options_.l1_tol_rel;
-    solver.max_sweeps = options_.l1_max_sweeps;
-    solver.relaxation = options_.l1_relaxation;
+    solver.max_newton_steps = options_.l1_max_steps;
     std::vector<Vec3> moved(s.position);
     std::vector<int> sweeps(static_cast<size_t>(n), 0);
     std::vector<char> converged(static_cast<size_t>(n), 1);
@@ -187,8 +185,7 @@ class Optimizer {
           const Vec3& g = cells.gradient[m];
           if (g.squaredNorm() < 0.25) continue;  // a source that cannot tell: no tangent plane
           const Vec3 a = g.normalized();
-          problem.a.push_back(a);
-          problem.b.push_back((a.dot(cells.point[m] - x0) - cells.distance[m]) * inv_l);
+          problem.AddTerm(a, (a.dot(cells.point[m] - x0) - cells.distance[m]) * inv_l);
         }
         if (problem.a.empty()) continue;
         for (size_t k = cells.neighbour_offset[i]; k < cells.neighbour_offset[i + 1]; ++k) {
@@ -213,10 +210,10 @@ class Optimizer {
     }
     const size_t failed = std::count(converged.begin(), converged.end(), 0);
     const double mean_sweeps = std::accumulate(sweeps.begin(), sweeps.end(), 0.0) / static_cast<double>(n);
-    monitor_.Debug(Format("L1 step: %.1f dual sweeps per seed on average", mean_sweeps));
+    monitor_.Debug(Format("L1 step: %.1f Newton steps per seed on average", mean_sweeps));
     if (failed > 0)
-      monitor_.Debug(std::to_string(failed) + " L1 steps hit --l1-max-sweeps before the gap certificate "
-                     "(their feasible best point is used)");
+      monitor_.Debug(std::to_string(failed) + " L1 steps hit --l1-max-steps before the gap certificate "
+                     "(their best feasible point is used)");
     return moved;
   }
 
@@ -435,7 +432,13 @@ SeedCloud OptimizeSeeds(const Udf& udf, const SeedCloud& input, const OptimizeSe
       break;
     }
   }
-  // Ranks at the final positions, for build-gvd and the viewer.
+  // A last L1 step: repulsion moves a seed on a curved feature (a circle) along its tangent, and projection
+  // brings it back to the surface but not exactly onto the feature. Then the ranks at the final positions.
+  if (options.max_outer_iters > 0) {
+    const CellSamples cells = opt.Analyze(s);
+    const std::vector<Vec3> before = s.position;
+    opt.Project(s, before, opt.L1Step(s, cells), 0.25 * opt.MeanSpacing(s.position));
+  }
   opt.Analyze(s);
   OuterIterationReport final_report;
   CountRanks(s, final_report);

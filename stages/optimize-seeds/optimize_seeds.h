@@ -25,8 +25,7 @@ struct OptimizeSeedsOptions {
   double max_step = 0.5;          ///< trust region: a repulsion round moves a seed at most this many σ (--max-step)
   double repulsion_cutoff = 3.0;  ///< neighbours interact within this many σ (kernel 1.1e-2 at 3σ) (--repulsion-cutoff)
   double l1_tol_rel = 1e-6;       ///< L1 step solved to this position accuracy, relative to the diagonal (--l1-tol-rel)
-  double l1_relaxation = 1.0;     ///< over-relaxation ω of the dual coordinate ascent, in (0, 2) (--l1-relaxation)
-  int l1_max_sweeps = 2000;       ///< dual coordinate-ascent sweeps before the L1 step gives up (--l1-max-sweeps)
+  int l1_max_steps = 200;         ///< Newton steps of the L1 step's barrier method before it gives up (--l1-max-steps)
   double move_tol = 1e-3;         ///< an inner loop moving no seed farther than move_tol·σ "makes no update" (--move-tol)
   double proj_tol_rel = 1e-5;     ///< projection tolerance on d, relative to the diagonal (as sample-seeds) (--proj-tol-rel)
   int proj_max_iters = 50;        ///< projection steps before a move is undone (--proj-max-iters)
@@ -54,7 +53,8 @@ struct OuterIterationReport {
 /// tangent-plane matrix, Gaussian repulsion over neighbours within repulsion_cutoff·σ minimised with L-BFGS
 /// in the null spaces (repulsion.h), projection — until the projected gradient's norm changes by less than δ
 /// relatively or max_inner_iters. The outer loop ends when an inner loop moves no seed farther than
-/// move_tol·σ, or after max_outer_iters (σ is taken over pairs with at least one movable seed). Finally ranks are recomputed at the final positions.
+/// move_tol·σ, or after max_outer_iters (σ is taken over pairs with at least one movable seed). A last L1
+/// step puts seeds that slid along a curved feature back onto it; ranks are recomputed at the final positions.
 /// Output seeds lie on the zero set (d < proj_tol_rel·diagonal) with their UDF value, gradient and rank.
 /// `on_iteration` (optional) sees the seeds after every outer iteration (for --trace).
 /// Deterministic for given inputs and options, also across thread counts (fixed-order reductions,

@@ -51,12 +51,9 @@ CellSamples SampleVoronoiCells(const Udf& udf, const std::vector<Vec3>& seeds, c
       uint64_t drawn = 0;
       while (count < m_max && drawn < budget) {
         ++drawn;
-        // Uniform in the ball: uniform direction, radius ∝ cube root of a uniform.
-        const double z = rng.Uniform(-1.0, 1.0);
-        const double phi = rng.Uniform(0.0, 2.0 * M_PI);
-        const double rho = r * std::cbrt(rng.Uniform());
-        const double s = std::sqrt(std::max(0.0, 1.0 - z * z));
-        const Vec3 q(rho * s * std::cos(phi), rho * s * std::sin(phi), rho * z);
+        // Uniform in the ball by rejection from its bounding cube (52 % kept; cheaper than trigonometry).
+        const Vec3 q(rng.Uniform(-r, r), rng.Uniform(-r, r), rng.Uniform(-r, r));
+        if (q.squaredNorm() > r * r) continue;
         // q is nearer x_i than x_j  ⇔  (x_j − x_i)ᵀq ≤ ‖x_j − x_i‖²/2; neighbours nearest first reject early.
         bool inside = true;
         for (size_t k = 0; k < offsets.size() && inside; ++k) inside = offsets[k].dot(q) <= half_sq[k];

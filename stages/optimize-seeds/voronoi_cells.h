@@ -15,7 +15,7 @@ struct CellSamplingOptions {
   int samples_per_cell = 100;    ///< M
   int radius_knn = 6;            ///< k: the cell is bounded by a ball of radius factor × (distance to the k-th nearest seed)
   double radius_factor = 1.5;
-  int max_draws_per_sample = 50; ///< rejection budget: at most M × this draws per cell
+  int max_draws_per_sample = 100; ///< rejection budget: at most M × this draws (in the ball's bounding cube) per cell
 };
 
 /// Per seed i: the bounding radius R_i, the seeds within 2 R_i (the only ones whose bisector planes can cut
@@ -29,11 +29,11 @@ struct CellSamples {
   std::vector<Vec3> point;
   std::vector<double> distance;
   std::vector<Vec3> gradient;
-  uint64_t draws = 0;                    ///< candidate points drawn in total (acceptance = point.size() / draws)
+  uint64_t draws = 0;                    ///< candidate points drawn in the bounding cubes (acceptance = point.size() / draws)
   size_t short_cells = 0;                ///< cells that got fewer than M samples within the budget
 };
 
-/// Draws up to M points uniformly in Ω_i ∩ B(x_i, R_i) for every seed by rejection from the ball (exact
+/// Draws up to M points uniformly in Ω_i ∩ B(x_i, R_i) for every seed by rejection from the ball's bounding cube (exact
 /// nearest-seed test against the seeds within 2 R_i, found with PCL's kd-tree), then evaluates the UDF at
 /// all of them in one batch. Seed i draws from the counter-based stream (rng_seed, round · N + i), so the
 /// result does not depend on the thread count. \pre seeds.size() ≥ 2, index built over `seeds`.
