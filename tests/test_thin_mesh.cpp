@@ -216,7 +216,7 @@ TEST(ThinMesh, NonManifoldEdgesAreExtracted) {
 
 TEST(ThinMesh, BadOptionsAreUsageErrors) {
   ThinMeshOptions o;
-  o.degenerate_area_rel = -1;
+  o.degenerate_quality = -1;
   EXPECT_THROW(o.Check(), UsageError);
 }
 
@@ -261,7 +261,7 @@ TEST_F(ThinMeshExe, BadInputExitsThreeAndWritesNothing) {
   EXPECT_FALSE(test::Exists(dir_ / "out.ply"));
   // A bad option value.
   r = RunProgram("thin-mesh", {"--udf", "shape:disc", "-i", dir_ / "seeds.ply", "-o", dir_ / "out.ply",
-                               "--degenerate-area-rel", "-1"});
+                               "--degenerate-quality", "-1"});
   EXPECT_EQ(r.exit_code, 2) << r.err;
   EXPECT_EQ(dir_.List().size(), 2u) << "only bad.ply and seeds.ply";
 }

@@ -19,8 +19,8 @@ int main(int argc, char** argv) {
   auto& app = cli.app();
   app.add_option("--min-component-faces", options.min_component_faces,
                  "components with fewer faces are removed (unless that opens a hole)");
-  app.add_option("--degenerate-area-rel", options.degenerate_area_rel,
-                 "faces with area at most this x diagonal^2 are dropped as degenerate");
+  app.add_option("--degenerate-quality", options.degenerate_quality,
+                 "faces with triangle quality below this are dropped as degenerate (0: only zero area)");
 
   return cli.Run(argc, argv, [&] { options.Check(); }, [&](voroudf::Monitor& monitor) {
     const auto udf = voroudf::OpenUdf(udf_spec, cli.udf_options());

@@ -261,16 +261,14 @@ std::string Count(size_t n, const char* what) { return std::to_string(n) + " " +
 
 void ThinMeshOptions::Check() const {
   if (min_component_faces > 1000000) throw UsageError("--min-component-faces must be at most 1e6");
-  if (!(degenerate_area_rel >= 0.0 && degenerate_area_rel < 1e-3))
-    throw UsageError("--degenerate-area-rel must be in [0, 1e-3)");
+  if (!(degenerate_quality >= 0.0 && degenerate_quality < 0.5))
+    throw UsageError("--degenerate-quality must be in [0, 0.5)");
 }
 
 TriangleMesh ThinMesh(const Udf& udf, const TriangleMesh& thick, const ThinMeshOptions& options, Monitor& monitor,
                       ThinMeshStats* stats_out) {
   options.Check();
   ThinMeshStats st;
-  const double diag = udf.Domain().Diagonal();
-  const double min_area = options.degenerate_area_rel * diag * diag;
 
   // 0. Degenerate and duplicate faces.
   std::vector<Tri> faces;
@@ -281,11 +279,10 @@ TriangleMesh ThinMesh(const Udf& udf, const TriangleMesh& thick, const ThinMeshO
       ++st.degenerate_faces;
       continue;
     }
-    const Vec3& a = thick.vertices[static_cast<size_t>(t[0])];
-    const double area = 0.5 * (thick.vertices[static_cast<size_t>(t[1])] - a)
-                                  .cross(thick.vertices[static_cast<size_t>(t[2])] - a)
-                                  .norm();
-    if (!(area > min_area)) {
+    const double quality = TriangleQuality(thick.vertices[static_cast<size_t>(t[0])],
+                                           thick.vertices[static_cast<size_t>(t[1])],
+                                           thick.vertices[static_cast<size_t>(t[2])]);
+    if (!(quality >= options.degenerate_quality) || quality == 0.0) {
       ++st.degenerate_faces;
       continue;
     }

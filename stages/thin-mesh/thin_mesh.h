@@ -14,9 +14,10 @@ namespace voroudf {
 struct ThinMeshOptions {
   /// Components with fewer faces than this are removed (--min-component-faces; paper: 10).
   size_t min_component_faces = 10;
-  /// A face is degenerate when it repeats a vertex or its area is at most this times the squared domain
-  /// diagonal (--degenerate-area-rel); coincident seeds give such faces.
-  double degenerate_area_rel = 1e-14;
+  /// A face is degenerate when it repeats a vertex or its triangle quality (6/sqrt3 area / (half-perimeter x
+  /// longest edge), 1 for equilateral) is below this (--degenerate-quality). Three seeds on one straight
+  /// sharp edge give such slivers (quality ~1e-6), as do coincident seeds (0).
+  double degenerate_quality = 1e-3;
 
   /// Throws UsageError for values that cannot work.
   void Check() const;
@@ -51,7 +52,7 @@ struct ThinMeshStats {
 ///     polyhedra ("non-manifold polyhedral artifacts", Sec. 3.4) go, while a surface is never cut open.
 ///  3. Steps 1–2 repeat until neither changes the mesh; unreferenced vertices are dropped (order kept).
 ///
-/// \param udf    the field, for the centroid values; its domain diagonal scales degenerate_area_rel
+/// \param udf    the field, for the centroid values
 /// \param thick  vertices + faces with valid indices (the caller validates them)
 /// \param stats  optional counts
 /// Deterministic (faces keep their input order), independent of the thread count.
