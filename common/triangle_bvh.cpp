@@ -5,6 +5,18 @@
 #include <cmath>
 #include <limits>
 
+#ifdef __SSE2__
+#include <emmintrin.h>
+#endif
+
+// The traversal keeps its running best in registers only if the per-triangle test is inlined at each of
+// its call sites, which GCC does not do on its own for a lambda called from four places.
+#if defined(__GNUC__)
+#define VOROUDF_ALWAYS_INLINE __attribute__((always_inline))
+#else
+#define VOROUDF_ALWAYS_INLINE
+#endif
+
 namespace voroudf {
 namespace {
 
@@ -241,8 +253,8 @@ void TriangleBvh::SetChild(int node, int c, const ChildRef& ref) {
   nd.count[c] = ref.count;
   for (int k = 0; k < 3; ++k) {
     // An empty box (the missing sibling of a one-leaf tree) stays +inf/-inf: infinitely far, never visited.
-    nd.lo[c][k] = ref.box.isEmpty() ? std::numeric_limits<float>::infinity() : RoundDown(ref.box.min()[k]);
-    nd.hi[c][k] = ref.box.isEmpty() ? -std::numeric_limits<float>::infinity() : RoundUp(ref.box.max()[k]);
+    nd.lo[k][c] = ref.box.isEmpty() ? std::numeric_limits<float>::infinity() : RoundDown(ref.box.min()[k]);
+    nd.hi[k][c] = ref.box.isEmpty() ? -std::numeric_limits<float>::infinity() : RoundUp(ref.box.max()[k]);
   }
 }
 
@@ -250,16 +262,45 @@ void TriangleBvh::SetChild(int node, int c, const ChildRef& ref) {
 
 namespace {
 
-inline double BoxSqDistance(const float* lo, const float* hi, double px, double py, double pz) {
-  const double dx = std::max({static_cast<double>(lo[0]) - px, 0.0, px - static_cast<double>(hi[0])});
-  const double dy = std::max({static_cast<double>(lo[1]) - py, 0.0, py - static_cast<double>(hi[1])});
-  const double dz = std::max({static_cast<double>(lo[2]) - pz, 0.0, pz - static_cast<double>(hi[2])});
-  return dx * dx + dy * dy + dz * dz;
+// Squared distances from (px, py, pz) to the two child boxes of a node, lower bounds in double of the
+// float boxes (which are rounded outwards). SSE2 (every x86-64) does both children at once.
+template <typename NodeT>
+inline void ChildSqDistances(const NodeT& nd, double px, double py, double pz, double* d0, double* d1) {
+#ifdef __SSE2__
+  const __m128d zero = _mm_setzero_pd();
+  auto axis = [&](const float* lo, const float* hi, double p) {
+    const __m128d vp = _mm_set1_pd(p);
+    const __m128d l = _mm_cvtps_pd(_mm_castsi128_ps(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(lo))));
+    const __m128d h = _mm_cvtps_pd(_mm_castsi128_ps(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(hi))));
+    const __m128d d = _mm_max_pd(_mm_max_pd(_mm_sub_pd(l, vp), _mm_sub_pd(vp, h)), zero);
+    return _mm_mul_pd(d, d);
+  };
+  const __m128d sum = _mm_add_pd(_mm_add_pd(axis(nd.lo[0], nd.hi[0], px), axis(nd.lo[1], nd.hi[1], py)),
+                                 axis(nd.lo[2], nd.hi[2], pz));
+  _mm_storel_pd(d0, sum);
+  _mm_storeh_pd(d1, sum);
+#else
+  double s[2];
+  for (int c = 0; c < 2; ++c) {
+    const double dx = std::max({static_cast<double>(nd.lo[0][c]) - px, 0.0, px - static_cast<double>(nd.hi[0][c])});
+    const double dy = std::max({static_cast<double>(nd.lo[1][c]) - py, 0.0, py - static_cast<double>(nd.hi[1][c])});
+    const double dz = std::max({static_cast<double>(nd.lo[2][c]) - pz, 0.0, pz - static_cast<double>(nd.hi[2][c])});
+    s[c] = dx * dx + dy * dy + dz * dz;
+  }
+  *d0 = s[0];
+  *d1 = s[1];
+#endif
 }
 
 }  // namespace
 
 TriangleBvh::Hit TriangleBvh::Closest(const Vec3& p, int hint) const {
+  if (!p.allFinite()) {  // NaN would slip through the SIMD max(., 0) and visit every box
+    Hit none;
+    none.sq_distance = std::numeric_limits<double>::quiet_NaN();
+    none.point = Vec3::Constant(std::numeric_limits<double>::quiet_NaN());
+    return none;
+  }
   const double px = p.x(), py = p.y(), pz = p.z();
   double best = std::numeric_limits<double>::infinity();
   // Boxes and planes are pruned only beyond `bound` = (sqrt(best) + tie_slack_)^2, so that every triangle
@@ -269,7 +310,7 @@ TriangleBvh::Hit TriangleBvh::Closest(const Vec3& p, int hint) const {
   double bx = 0, by = 0, bz = 0;
   int best_slot = -1;
 
-  auto test_triangle = [&](int s) {
+  auto test_triangle = [&](int s) VOROUDF_ALWAYS_INLINE {
     const PackedTri& t = tris_[s];
     const double apx = px - t.a[0], apy = py - t.a[1], apz = pz - t.a[2];
     // The distance to the triangle's plane bounds the distance from below: many triangles of a
@@ -302,7 +343,7 @@ TriangleBvh::Hit TriangleBvh::Closest(const Vec3& p, int hint) const {
   };
   if (hint >= 0 && hint < static_cast<int>(tris_.size())) test_triangle(hint);
 
-  auto test_leaf = [&](int first, int count) {
+  auto test_leaf = [&](int first, int count) VOROUDF_ALWAYS_INLINE {
     for (int s = first, e = first + count; s < e; ++s) {
       test_triangle(s);
     }
@@ -317,8 +358,8 @@ TriangleBvh::Hit TriangleBvh::Closest(const Vec3& p, int hint) const {
   int node = 0;
   for (;;) {
     const Node& nd = nodes_[node];
-    const double d0 = BoxSqDistance(nd.lo[0], nd.hi[0], px, py, pz);
-    const double d1 = BoxSqDistance(nd.lo[1], nd.hi[1], px, py, pz);
+    double d0, d1;
+    ChildSqDistances(nd, px, py, pz, &d0, &d1);
     const int nc = d1 < d0 ? 1 : 0;  // nearer child first; the left one on ties
     const double dnear = nc ? d1 : d0, dfar = nc ? d0 : d1;
     const int near_index = nd.child[nc], near_count = nd.count[nc];

@@ -59,8 +59,8 @@ class TriangleBvh {
   // line. Child c is a leaf of count[c] > 0 triangles starting at slot child[c] of tris_, or (count 0) the
   // inner node nodes_[child[c]]. Float bounds, rounded outwards, keep a node at 64 bytes.
   struct alignas(64) Node {
-    float lo[2][3];
-    float hi[2][3];
+    float lo[3][2];  // [axis][child]: both children's bounds along an axis side by side (SIMD loads)
+    float hi[3][2];
     int32_t child[2];
     int32_t count[2];
   };
