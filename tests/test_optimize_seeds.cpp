@@ -29,6 +29,8 @@ using test::TempDir;
 
 // ---------------------------------------------------------------------------------------------- L1 solver
 
+SeedCloud Initial(const Udf& udf, size_t count, uint64_t seed);
+
 // Samples of exact tangent planes through the origin with normals `planes`, seen from random points around
 // x0 (as UDF samples of the surface would be: n = ±plane normal, d = |distance|), in coordinates centred on x0.
 L1TangentProblem PlanesProblem(const std::vector<Vec3>& planes, const Vec3& x0, int per_plane, double gamma) {
@@ -370,6 +372,38 @@ TEST(Repulsion, ProjectedStepKeepsRankTwoSeedsOnTheCubeEdge) {
     slid = std::max(slid, std::abs(r.positions[i].z() - seeds[i].z()));
   }
   EXPECT_GT(slid, 1e-3) << "the edge seeds did not move along the edge at all";
+}
+
+TEST(VoronoiCells, SamplesLieInTheirCellAndUnchangedCellsAreKept) {
+  const auto sphere = MakeShape("sphere");
+  std::vector<Vec3> seeds = Initial(*sphere, 300, 8).position;
+  auto check_membership = [&](const CellSamples& cells) {
+    for (size_t i = 0; i < seeds.size(); ++i) {
+      EXPECT_GT(cells.sample_offset[i + 1] - cells.sample_offset[i], 0u) << "cell " << i;
+      for (size_t m = cells.sample_offset[i]; m < cells.sample_offset[i + 1]; ++m) {
+        const Vec3& q = cells.point[m];
+        ASSERT_LE((q - seeds[i]).norm(), cells.radius[i] * (1 + 1e-12));
+        for (size_t j = 0; j < seeds.size(); ++j)
+          ASSERT_LE((q - seeds[i]).norm(), (q - seeds[j]).norm() + 1e-12) << "sample of cell " << i << " nearer seed " << j;
+        EXPECT_NEAR(cells.distance[m], sphere->Distance(q), 1e-12);
+      }
+    }
+  };
+  const SeedIndex index0(seeds);
+  const CellSamples first = SampleVoronoiCells(*sphere, seeds, index0, CellSamplingOptions(), 1, 0);
+  check_membership(first);
+  // Nothing moved: every cell is kept.
+  const CellSamples same = SampleVoronoiCells(*sphere, seeds, index0, CellSamplingOptions(), 1, 1, &first, &seeds);
+  EXPECT_EQ(same.redrawn, 0u);
+  EXPECT_EQ(same.point, first.point);
+  // One seed moves: only cells near it are redrawn, and every cell is still exact.
+  const std::vector<Vec3> before = seeds;
+  seeds[0] = (seeds[0] + Vec3(0.01, 0.0, 0.0)).normalized() * 0.5;
+  const SeedIndex index1(seeds);
+  const CellSamples after = SampleVoronoiCells(*sphere, seeds, index1, CellSamplingOptions(), 1, 2, &first, &before);
+  EXPECT_GE(after.redrawn, 1u);
+  EXPECT_LT(after.redrawn, 60u);  // of 300
+  check_membership(after);
 }
 
 // ---------------------------------------------------------------------------------------------- shapes

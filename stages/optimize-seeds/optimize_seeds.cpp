@@ -133,7 +133,8 @@ class Optimizer {
   // Cells, samples, rank and null space of every seed at the current positions.
   CellSamples Analyze(State& s) {
     const SeedIndex index(s.position);
-    CellSamples cells = SampleVoronoiCells(udf_, s.position, index, cell_options_, options_.seed, round_++);
+    CellSamples cells = SampleVoronoiCells(udf_, s.position, index, cell_options_, options_.seed, round_++,
+                                           cached_positions_.empty() ? nullptr : &cached_cells_, &cached_positions_);
     const long n = static_cast<long>(s.position.size());
 #pragma omp parallel for schedule(static)
     for (long i = 0; i < n; ++i) {
@@ -154,8 +155,11 @@ class Optimizer {
       }
       s.rank[i] = r;
     }
+    cached_cells_ = cells;
+    cached_positions_ = s.position;
     last_short_cells_ = cells.short_cells;
-    last_acceptance_ = cells.draws ? static_cast<double>(cells.point.size()) / static_cast<double>(cells.draws) : 0.0;
+    if (cells.draws) last_acceptance_ = static_cast<double>(cells.drawn_samples) / static_cast<double>(cells.draws);
+    monitor_.Debug("cells: " + std::to_string(cells.redrawn) + " of " + std::to_string(n) + " redrawn");
     return cells;
   }
 
@@ -294,6 +298,8 @@ class Optimizer {
   CellSamplingOptions cell_options_;
   ProjectionOptions projection_;
   uint64_t round_ = 0;  // sampling rounds so far: the random stream of every round differs
+  CellSamples cached_cells_;             // the last round's cells, reused where nothing nearby moved
+  std::vector<Vec3> cached_positions_;
   size_t last_short_cells_ = 0;
   double last_acceptance_ = 0.0;
 };

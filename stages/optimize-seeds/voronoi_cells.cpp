@@ -7,8 +7,19 @@
 
 namespace voroudf {
 
+namespace {
+
+// The radius around x_i inside which any moved seed can change cell i: its cutting neighbours lie within
+// 2R_i and its k-th nearest seed (which sets R_i) within R_i / radius_factor.
+double InfluenceRadius(double r, const CellSamplingOptions& options) {
+  return std::max(2.0, 1.0 / options.radius_factor) * r * (1.0 + 1e-5) + 1e-12;
+}
+
+}  // namespace
+
 CellSamples SampleVoronoiCells(const Udf& udf, const std::vector<Vec3>& seeds, const SeedIndex& index,
-                               const CellSamplingOptions& options, uint64_t rng_seed, uint64_t round) {
+                               const CellSamplingOptions& options, uint64_t rng_seed, uint64_t round,
+                               const CellSamples* previous, const std::vector<Vec3>* previous_seeds) {
   const size_t n = seeds.size();
   const size_t m_max = static_cast<size_t>(options.samples_per_cell);
   CellSamples cells;
@@ -18,6 +29,32 @@ CellSamples SampleVoronoiCells(const Udf& udf, const std::vector<Vec3>& seeds, c
   std::vector<size_t> accepted(n, 0);
   std::vector<uint64_t> draws(n, 0);
 
+  // Which cells must be redrawn: all, or (given the previous round) those with a moved seed within their
+  // influence radius, before or after the move.
+  std::vector<char> redo(n, 1);
+  const bool incremental = previous && previous_seeds && previous_seeds->size() == n && previous->radius.size() == n;
+  if (incremental) {
+    std::vector<char> moved(n);
+    for (size_t i = 0; i < n; ++i) moved[i] = seeds[i] != (*previous_seeds)[i];
+#pragma omp parallel
+    {
+      std::vector<int> found;
+#pragma omp for schedule(dynamic, 64)
+      for (long li = 0; li < static_cast<long>(n); ++li) {
+        const size_t i = static_cast<size_t>(li);
+        if (moved[i]) continue;
+        bool dirty = false;
+        for (size_t k = previous->neighbour_offset[i]; k < previous->neighbour_offset[i + 1] && !dirty; ++k)
+          dirty = moved[static_cast<size_t>(previous->neighbour[k])];
+        if (!dirty) {
+          index.WithinRadius(seeds[i], InfluenceRadius(previous->radius[i], options), found);
+          for (int j : found) dirty = dirty || moved[static_cast<size_t>(j)];
+        }
+        redo[i] = dirty;
+      }
+    }
+  }
+
 #pragma omp parallel
   {
     std::vector<int> knn, found;
@@ -26,6 +63,12 @@ CellSamples SampleVoronoiCells(const Udf& udf, const std::vector<Vec3>& seeds, c
 #pragma omp for schedule(dynamic, 64)
     for (long li = 0; li < static_cast<long>(n); ++li) {
       const size_t i = static_cast<size_t>(li);
+      if (!redo[i]) {
+        cells.radius[i] = previous->radius[i];
+        neighbours[i].assign(previous->neighbour.begin() + static_cast<long>(previous->neighbour_offset[i]),
+                             previous->neighbour.begin() + static_cast<long>(previous->neighbour_offset[i + 1]));
+        continue;
+      }
       const Vec3& xi = seeds[i];
       index.Nearest(xi, options.radius_knn + 1, knn);
       double kth = 0.0;
@@ -64,22 +107,49 @@ CellSamples SampleVoronoiCells(const Udf& udf, const std::vector<Vec3>& seeds, c
     }
   }
 
+  // Assemble; only the redrawn cells' samples go to the UDF.
   cells.neighbour_offset.assign(n + 1, 0);
   cells.sample_offset.assign(n + 1, 0);
   for (size_t i = 0; i < n; ++i) {
+    const size_t count = redo[i] ? accepted[i] : previous->sample_offset[i + 1] - previous->sample_offset[i];
     cells.neighbour_offset[i + 1] = cells.neighbour_offset[i] + neighbours[i].size();
-    cells.sample_offset[i + 1] = cells.sample_offset[i] + accepted[i];
-    cells.draws += draws[i];
-    if (accepted[i] < m_max) ++cells.short_cells;
+    cells.sample_offset[i + 1] = cells.sample_offset[i] + count;
+    if (redo[i]) {
+      cells.draws += draws[i];
+      cells.drawn_samples += accepted[i];
+      ++cells.redrawn;
+    }
+    if (count < m_max) ++cells.short_cells;
   }
   cells.neighbour.reserve(cells.neighbour_offset[n]);
   cells.point.resize(cells.sample_offset[n]);
+  cells.distance.resize(cells.sample_offset[n]);
+  cells.gradient.resize(cells.sample_offset[n]);
+  std::vector<Vec3> fresh;
+  std::vector<size_t> fresh_at;
   for (size_t i = 0; i < n; ++i) {
     cells.neighbour.insert(cells.neighbour.end(), neighbours[i].begin(), neighbours[i].end());
-    std::copy_n(candidates.begin() + static_cast<long>(i * m_max), accepted[i],
-                cells.point.begin() + static_cast<long>(cells.sample_offset[i]));
+    const long to = static_cast<long>(cells.sample_offset[i]);
+    if (redo[i]) {
+      std::copy_n(candidates.begin() + static_cast<long>(i * m_max), accepted[i], cells.point.begin() + to);
+      for (size_t k = 0; k < accepted[i]; ++k) fresh_at.push_back(cells.sample_offset[i] + k);
+    } else {
+      const long from = static_cast<long>(previous->sample_offset[i]);
+      const long count = static_cast<long>(previous->sample_offset[i + 1]) - from;
+      std::copy_n(previous->point.begin() + from, count, cells.point.begin() + to);
+      std::copy_n(previous->distance.begin() + from, count, cells.distance.begin() + to);
+      std::copy_n(previous->gradient.begin() + from, count, cells.gradient.begin() + to);
+    }
   }
-  udf.Evaluate(cells.point, cells.distance, cells.gradient);
+  fresh.resize(fresh_at.size());
+  for (size_t k = 0; k < fresh_at.size(); ++k) fresh[k] = cells.point[fresh_at[k]];
+  std::vector<double> d;
+  std::vector<Vec3> g;
+  udf.Evaluate(fresh, d, g);
+  for (size_t k = 0; k < fresh_at.size(); ++k) {
+    cells.distance[fresh_at[k]] = d[k];
+    cells.gradient[fresh_at[k]] = g[k];
+  }
   return cells;
 }
 

@@ -29,15 +29,24 @@ struct CellSamples {
   std::vector<Vec3> point;
   std::vector<double> distance;
   std::vector<Vec3> gradient;
-  uint64_t draws = 0;                    ///< candidate points drawn in the bounding cubes (acceptance = point.size() / draws)
+  uint64_t draws = 0;                    ///< candidate points drawn in the bounding cubes in this call
+  uint64_t drawn_samples = 0;            ///< of which accepted (acceptance = drawn_samples / draws)
   size_t short_cells = 0;                ///< cells that got fewer than M samples within the budget
+  size_t redrawn = 0;                    ///< cells sampled in this call (the others were kept)
 };
 
 /// Draws up to M points uniformly in Ω_i ∩ B(x_i, R_i) for every seed by rejection from the ball's bounding cube (exact
 /// nearest-seed test against the seeds within 2 R_i, found with PCL's kd-tree), then evaluates the UDF at
 /// all of them in one batch. Seed i draws from the counter-based stream (rng_seed, round · N + i), so the
 /// result does not depend on the thread count. \pre seeds.size() ≥ 2, index built over `seeds`.
+///
+/// Incremental use: given the previous call's result and seed positions, a cell is kept as it was (same
+/// radius, neighbours, samples and UDF values) when no seed within its influence radius (2R_i, and the
+/// distance of its k-th nearest seed) moved, before or after the move — such a cell is exactly the same
+/// set, so redrawing it would only change the random draw. Early on, when σ is small and few seeds
+/// move, this saves most of the UDF evaluations.
 CellSamples SampleVoronoiCells(const Udf& udf, const std::vector<Vec3>& seeds, const SeedIndex& index,
-                               const CellSamplingOptions& options, uint64_t rng_seed, uint64_t round);
+                               const CellSamplingOptions& options, uint64_t rng_seed, uint64_t round,
+                               const CellSamples* previous = nullptr, const std::vector<Vec3>* previous_seeds = nullptr);
 
 }  // namespace voroudf
