@@ -32,7 +32,10 @@ MeshUdf::MeshUdf(TriangleMesh mesh, std::string name, const MeshUdfOptions& opti
   }
   bbox_ = {bb.min(), bb.max()};
   domain_ = bbox_.Inflated(options_.margin_rel * extent);
-  const double on_surface = 1e-12 * extent;
+  // Rounding in x - c grows with the coordinates' magnitude, not only the extent (a 1 m part placed at
+  // 1 km): below this the direction x - c is noise.
+  const double magnitude = std::max(bbox_.min.cwiseAbs().maxCoeff(), bbox_.max.cwiseAbs().maxCoeff());
+  const double on_surface = 1e-12 * std::max(extent, magnitude);
   on_surface_sq_ = on_surface * on_surface;
   bvh_ = std::make_unique<TriangleBvh>(mesh_.vertices, mesh_.faces);
 }

@@ -22,7 +22,8 @@ struct MeshUdfOptions {
 /// alone (connectivity is ignored), so open, non-manifold, multi-component meshes and STL soups with
 /// duplicate or degenerate faces all work.
 ///
-/// Gradient: (x - c)/|x - c| with c the closest point. Where d <= 1e-12 * (largest bbox extent) (on the
+/// Gradient: (x - c)/|x - c| with c the closest point. Where d <= 1e-12 * max(largest bbox extent,
+/// largest |coordinate|) (on the
 /// surface, where the UDF has a kink) it is the unit normal of the closest triangle, oriented towards x
 /// when that side can be told (n.(x - c) >= 0), else as stored; a degenerate triangle's normal is a
 /// deterministic unit vector orthogonal to its longest edge. On the medial axis: the direction to the
