@@ -88,7 +88,7 @@ std::string StageCli::EffectiveOptions(bool semantic_only) const {
     if (!opt->nonpositional()) continue;
     const std::string name = opt->get_name();
     if (name == "--help" || (semantic_only && non_semantic_.count(name))) continue;
-    const bool is_flag = opt->get_type_size_max() == 0;
+    const bool is_flag = opt->get_expected_max() == 0;  // add_flag: takes no value
     std::string value;
     if (opt->count() > 0) {
       for (const auto& r : opt->results()) value += (value.empty() ? "" : " ") + Quoted(r);

@@ -91,7 +91,11 @@ TEST_F(SampleSeedsExe, SameSeedSameBytesWhateverTheThreadCount) {
 TEST_F(SampleSeedsExe, ProvenanceAndAscii) {
   auto args = Args("cube", dir_ / "s.ply");
   args.push_back("--ascii");
-  ASSERT_EQ(RunProgram("sample-seeds", args).exit_code, 0);
+  const auto r = RunProgram("sample-seeds", args);
+  ASSERT_EQ(r.exit_code, 0);
+  // The echo of the options can be pasted back: flags appear bare, never as "--ascii true".
+  EXPECT_NE(r.err.find("--ascii"), std::string::npos);
+  EXPECT_EQ(r.err.find("--ascii true"), std::string::npos) << r.err;
   const std::string text = test::ReadBytes(dir_ / "s.ply");
   EXPECT_NE(text.find("format ascii 1.0"), std::string::npos);
   EXPECT_NE(text.find("comment voroudf seeds 1"), std::string::npos);
