@@ -46,20 +46,28 @@ struct OuterIterationReport {
   double seconds = 0.0;
 };
 
-/// Paper Alg. 1 lines 2–16. Input seeds are first projected onto the zero set (seeds that do not converge
-/// and exact duplicates are dropped, with a warning). Then, per outer iteration: (1) the constrained L1
-/// tangent step for every seed inside its Voronoi cell (l1_tangent.h); projection; (2) σ = minimum pairwise
-/// seed distance; (3) inner rounds of: cells and samples recomputed, rank and null space V₀ of every seed's
-/// tangent-plane matrix, Gaussian repulsion over neighbours within repulsion_cutoff·σ minimised with L-BFGS
-/// in the null spaces (repulsion.h), projection — until the projected gradient's norm changes by less than δ
-/// relatively or max_inner_iters. The outer loop ends when an inner loop moves no seed farther than
-/// move_tol·σ, or after max_outer_iters (σ is taken over pairs with at least one movable seed). A last L1
-/// step puts seeds that slid along a curved feature back onto it; ranks are recomputed at the final positions.
-/// Output seeds lie on the zero set (d < proj_tol_rel·diagonal) with their UDF value, gradient and rank.
-/// `on_iteration` (optional) sees the seeds after every outer iteration (for --trace).
-/// Deterministic for given inputs and options, also across thread counts (fixed-order reductions,
-/// per-seed random streams). Throws InputError for fewer than 2 distinct seeds, NumericalError if fewer
-/// than 2 seeds reach the surface.
+/// Paper Alg. 1 lines 2–16 (Sec. 3.1 Eqs. energy_l1 / energy_l1_regularizer, Sec. 3.2 Eqs. particle /
+/// particle_proj). Input seeds are first projected onto the zero set (seeds that do not converge and exact
+/// duplicates are dropped, with a warning). Then, per outer iteration: (1) the constrained L1 tangent step
+/// of every seed inside its Voronoi cell (l1_tangent.h), then projection; (2) σ = the minimum distance
+/// between seeds, over pairs with at least one movable (rank < 3) seed, capped at sigma_max_spacing × the
+/// mean nearest-neighbour distance; (3) inner rounds of: cells and samples recomputed (voronoi_cells.h),
+/// rank and null space V₀ of every seed's tangent-plane matrix, Gaussian repulsion over neighbours within
+/// repulsion_cutoff·σ minimised with L-BFGS in the null spaces (repulsion.h, trust region max_step·σ),
+/// projection — until the projected gradient's norm changes by less than δ relatively, or
+/// max_inner_iters. A move whose projection fails, or that lands a seed nearer to another than
+/// min(floor, its previous nearest distance), is undone. The outer loop ends when an inner loop moves no
+/// seed farther than move_tol·σ, or after max_outer_iters. A last L1 step puts seeds that slid along a
+/// curved feature back onto it; ranks are recomputed at the final positions.
+/// \param udf           the field (thread-safe batched queries); lengths are relative to its domain diagonal
+/// \param input         seeds (only positions are used); at least 2 distinct ones
+/// \param options       see OptimizeSeedsOptions; checked first (UsageError)
+/// \param monitor       logs one line per outer iteration and a progress task per outer iteration
+/// \param on_iteration  optional: sees the seeds after every outer iteration (for --trace)
+/// \return seeds on the zero set (d < proj_tol_rel·diagonal) with UDF value, gradient and rank, in input
+///         order. Deterministic for given inputs and options, also across thread counts (fixed-order
+///         reductions, per-seed random streams). Throws InputError for fewer than 2 distinct seeds,
+///         NumericalError if fewer than 2 seeds reach the surface.
 SeedCloud OptimizeSeeds(const Udf& udf, const SeedCloud& input, const OptimizeSeedsOptions& options, Monitor& monitor,
                         const std::function<void(const OuterIterationReport&, const SeedCloud&)>& on_iteration = {});
 
