@@ -1,6 +1,8 @@
 // sample-seeds: the library on every built-in shape, and the real executable end to end.
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include "common/errors.h"
 #include "common/shapes.h"
 #include "formats/seeds_io.h"
@@ -42,6 +44,57 @@ TEST(SampleSeeds, SeedsCoverTheWholeSurface) {
   int octant[8] = {0};
   for (const Vec3& p : seeds.position) ++octant[(p.x() > 0) + 2 * (p.y() > 0) + 4 * (p.z() > 0)];
   for (int c : octant) EXPECT_GT(c, 60);
+}
+
+// Seeds on a sharp edge of the cube have two coordinates at +-0.5.
+double FractionOnCubeEdges(const SeedCloud& seeds) {
+  size_t on_edge = 0;
+  for (const Vec3& p : seeds.position) {
+    int at_face = 0;
+    for (int k = 0; k < 3; ++k) at_face += std::abs(std::abs(p[k]) - 0.5) < 1e-9;
+    on_edge += at_face >= 2;
+  }
+  return static_cast<double>(on_edge) / static_cast<double>(seeds.size());
+}
+
+TEST(SampleSeeds, TheBandKeepsSeedsOffTheSharpEdges) {
+  const auto udf = MakeShape("cube");
+  SampleSeedsOptions options;
+  options.count = 2000;
+  options.band_rel = 0.0;  // the whole box: every draw in an edge's outer wedge lands on the edge
+  const double whole_box = FractionOnCubeEdges(SampleSeeds(*udf, options, Monitor::Null()));
+  options.band_rel = 0.01;
+  const SeedCloud banded = SampleSeeds(*udf, options, Monitor::Null());
+  const double band = FractionOnCubeEdges(banded);
+  // Expected shares: the edges' outer wedges over the faces' two-sided slabs, ~0.8 % for a band of
+  // 0.01 x diagonal; the whole box gives ~8 % here (more on shapes with more convex edges).
+  EXPECT_GT(whole_box, 0.05);
+  EXPECT_LT(band, 0.02);
+  EXPECT_LT(band, whole_box / 4);
+  EXPECT_EQ(banded.size(), options.count);
+  // The band draws are spread by area: every face of the cube gets about a sixth.
+  int per_face[6] = {0};
+  for (const Vec3& p : banded.position) {
+    int k = 0;
+    for (int i = 1; i < 3; ++i)
+      if (std::abs(p[i]) > std::abs(p[k])) k = i;
+    ++per_face[2 * k + (p[k] > 0)];
+  }
+  for (int c : per_face) EXPECT_NEAR(c, 2000 / 6.0, 80);
+}
+
+TEST(SampleSeeds, DuplicatesAreDropped) {
+  // Whole-box draws outside a cube corner all project onto the corner itself.
+  const auto udf = MakeShape("cube");
+  SampleSeedsOptions options;
+  options.count = 3000;
+  options.band_rel = 0.0;
+  const SeedCloud seeds = SampleSeeds(*udf, options, Monitor::Null());
+  EXPECT_LT(seeds.size(), options.count);
+  const double radius = options.dedup_rel * udf->Domain().Diagonal();
+  for (size_t i = 0; i < seeds.size(); ++i)
+    for (size_t j = i + 1; j < seeds.size(); ++j)
+      ASSERT_GE((seeds.position[i] - seeds.position[j]).norm(), radius);
 }
 
 TEST(SampleSeeds, BadOptionsAreUsageErrors) {

@@ -8,14 +8,17 @@ int main(int argc, char** argv) {
   bool ascii = false;
 
   voroudf::StageCli cli("sample-seeds",
-                        "Draws --count points uniformly in the UDF's domain box and projects each onto the zero set "
-                        "with x <- x - d(x) n(x); writes the converged ones as a seeds PLY.");
+                        "Draws --count points uniformly in the UDF's domain box (within a band around the surface) and "
+                        "projects each onto the zero set with x <- x - d(x) n(x); writes the converged ones as a seeds PLY.");
   cli.AddUdf(&udf_spec);
   cli.AddOutput(&output, "output seeds PLY (seeds0.ply)");
   cli.AddSeed(&options.seed);
   cli.AddAscii(&ascii);
   auto& app = cli.app();
-  app.add_option("-n,--count", options.count, "number of points drawn before projection");
+  app.add_option("-n,--count", options.count, "number of points drawn (inside the band) before projection");
+  app.add_option("--band-rel", options.band_rel,
+                 "keep only draws with d < band x diagonal (0: whole box); spreads seeds by area, not onto edges");
+  app.add_option("--dedup-rel", options.dedup_rel, "drop seeds closer than this x diagonal to an earlier one");
   app.add_option("--proj-tol-rel", options.proj_tol_rel,
                  "projection tolerance on d, relative to the domain box diagonal");
   app.add_option("--proj-max-iters", options.proj_max_iters, "projection steps before a seed is dropped");

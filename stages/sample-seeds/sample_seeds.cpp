@@ -1,10 +1,14 @@
 #include "stages/sample-seeds/sample_seeds.h"
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
+#include <unordered_map>
 
 #include "common/errors.h"
 #include "common/projection.h"
 #include "common/rng.h"
+#include "common/udf_spec.h"
 
 namespace voroudf {
 
@@ -13,41 +17,125 @@ void SampleSeedsOptions::Check() const {
   if (count > 100000000) throw UsageError("--count must be at most 1e8");
   if (!(proj_tol_rel > 0.0 && proj_tol_rel < 0.1)) throw UsageError("--proj-tol-rel must be in (0, 0.1)");
   if (proj_max_iters < 1) throw UsageError("--proj-max-iters must be at least 1");
+  if (!(band_rel >= 0.0)) throw UsageError("--band-rel must be >= 0");
+  if (!(dedup_rel >= 0.0 && dedup_rel < 0.1)) throw UsageError("--dedup-rel must be in [0, 0.1)");
 }
+
+namespace {
+
+Vec3 Candidate(const Box& box, uint64_t seed, uint64_t index) {
+  Rng rng(seed, index);
+  Vec3 p;
+  for (int k = 0; k < 3; ++k) p[k] = rng.Uniform(box.min[k], box.max[k]);
+  return p;
+}
+
+// The first `count` candidates (in index order) within the band. Candidates are evaluated in batches so
+// that every source, external processes included, sees large requests.
+std::vector<Vec3> DrawInBand(const Udf& udf, const Box& box, const SampleSeedsOptions& options, Monitor& monitor) {
+  std::vector<Vec3> points;
+  if (options.band_rel <= 0.0) {
+    points.resize(options.count);
+    for (size_t i = 0; i < options.count; ++i) points[i] = Candidate(box, options.seed, i);
+    return points;
+  }
+  const double band = options.band_rel * box.Diagonal();
+  // Give up after this many candidates: the band holds essentially none of the box.
+  const uint64_t max_candidates = std::max<uint64_t>(100000000, 1000 * options.count);
+  uint64_t next = 0;
+  std::vector<Vec3> batch;
+  std::vector<double> d;
+  std::vector<Vec3> g;
+  Task task(monitor, "drawing in the band", options.count);
+  while (points.size() < options.count && next < max_candidates) {
+    // Grow the batch with the observed acceptance rate (at least 64k candidates).
+    const double rate = next ? std::max(1e-4, static_cast<double>(points.size()) / static_cast<double>(next)) : 0.05;
+    const size_t want = options.count - points.size();
+    const size_t n = static_cast<size_t>(std::clamp(1.2 * static_cast<double>(want) / rate, 65536.0, 1e7));
+    batch.resize(n);
+    for (size_t k = 0; k < n; ++k) batch[k] = Candidate(box, options.seed, next + k);
+    udf.Evaluate(batch, d, g);
+    for (size_t k = 0; k < n && points.size() < options.count; ++k) {
+      if (d[k] < band) {
+        points.push_back(batch[k]);
+        task.Advance(1);
+      }
+    }
+    next += n;
+  }
+  char line[160];
+  std::snprintf(line, sizeof line, "%zu of %llu candidates fell within d < %.3g (band %g x diagonal)",
+                points.size(), static_cast<unsigned long long>(next), band, options.band_rel);
+  monitor.Info(line);
+  if (points.empty()) throw NumericalError("no point of the domain box lies within the band d < " + std::to_string(band) +
+                                           " of the surface of " + udf.Describe() + "; try a larger --band-rel");
+  return points;
+}
+
+// Indices (into `points`, in order) of the points with no earlier kept point closer than `radius`.
+std::vector<size_t> KeepDistinct(const std::vector<Vec3>& points, const std::vector<size_t>& candidates, double radius) {
+  if (radius <= 0.0) return candidates;
+  auto cell = [&](const Vec3& p, int k) { return static_cast<long long>(std::floor(p[k] / radius)); };
+  auto key = [](long long x, long long y, long long z) {
+    return static_cast<uint64_t>(x) * 73856093ull ^ static_cast<uint64_t>(y) * 19349663ull ^
+           static_cast<uint64_t>(z) * 83492791ull;
+  };
+  std::unordered_map<uint64_t, std::vector<size_t>> grid;
+  std::vector<size_t> kept;
+  for (size_t i : candidates) {
+    const Vec3& p = points[i];
+    const long long cx = cell(p, 0), cy = cell(p, 1), cz = cell(p, 2);
+    bool near = false;
+    for (long long dx = -1; dx <= 1 && !near; ++dx)
+      for (long long dy = -1; dy <= 1 && !near; ++dy)
+        for (long long dz = -1; dz <= 1 && !near; ++dz) {
+          const auto it = grid.find(key(cx + dx, cy + dy, cz + dz));
+          if (it == grid.end()) continue;
+          for (size_t j : it->second)
+            if ((points[j] - p).squaredNorm() < radius * radius) near = true;
+        }
+    if (near) continue;
+    grid[key(cx, cy, cz)].push_back(i);
+    kept.push_back(i);
+  }
+  return kept;
+}
+
+}  // namespace
 
 SeedCloud SampleSeeds(const Udf& udf, const SampleSeedsOptions& options, Monitor& monitor) {
   options.Check();
   const Box box = udf.Domain();
-  monitor.Info("domain box [" + std::to_string(box.min.x()) + "," + std::to_string(box.min.y()) + "," +
-               std::to_string(box.min.z()) + "] - [" + std::to_string(box.max.x()) + "," +
-               std::to_string(box.max.y()) + "," + std::to_string(box.max.z()) + "], diagonal " +
-               std::to_string(box.Diagonal()));
-  std::vector<Vec3> points(options.count);
-  for (size_t i = 0; i < options.count; ++i) {
-    Rng rng(options.seed, i);
-    for (int k = 0; k < 3; ++k) points[i][k] = rng.Uniform(box.min[k], box.max[k]);
-  }
+  monitor.Info("domain box " + FormatBox(box) + ", diagonal " + std::to_string(box.Diagonal()));
+  std::vector<Vec3> points = DrawInBand(udf, box, options, monitor);
   ProjectionOptions proj;
   proj.tolerance = options.proj_tol_rel * box.Diagonal();
   proj.max_iterations = options.proj_max_iters;
   const ProjectionResult r = ProjectToZeroSet(udf, points, proj, monitor);
 
+  std::vector<size_t> converged;
+  for (size_t i = 0; i < points.size(); ++i)
+    if (r.converged[i]) converged.push_back(i);
+  const std::vector<size_t> kept = KeepDistinct(points, converged, options.dedup_rel * box.Diagonal());
+
   SeedCloud seeds;
-  seeds.Resize(r.num_converged);
-  size_t k = 0;
-  for (size_t i = 0; i < points.size(); ++i) {
-    if (!r.converged[i]) continue;
-    seeds.position[k] = points[i];
-    seeds.normal[k] = r.gradient[i];
-    seeds.udf[k] = r.distance[i];
-    ++k;
+  seeds.Resize(kept.size());
+  for (size_t k = 0; k < kept.size(); ++k) {
+    seeds.position[k] = points[kept[k]];
+    seeds.normal[k] = r.gradient[kept[k]];
+    seeds.udf[k] = r.distance[kept[k]];
   }
   const size_t dropped = points.size() - r.num_converged;
-  char line[160];
+  char line[200];
   std::snprintf(line, sizeof line, "%zu of %zu seeds projected to d < %.3g; %zu dropped (not converged in %d steps)",
                 r.num_converged, points.size(), proj.tolerance, dropped, proj.max_iterations);
   if (dropped > 0) monitor.Warn(line);
   else monitor.Info(line);
+  if (kept.size() < converged.size()) {
+    std::snprintf(line, sizeof line, "%zu seeds dropped as duplicates (within %.3g of an earlier seed)",
+                  converged.size() - kept.size(), options.dedup_rel * box.Diagonal());
+    monitor.Info(line);
+  }
   if (r.num_converged == 0) throw NumericalError("no seed reached the surface of " + udf.Describe());
   return seeds;
 }
