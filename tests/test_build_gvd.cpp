@@ -216,9 +216,9 @@ TEST_F(BuildGvdExe, BadInputExitsThreeAndWritesNothing) {
   WriteMeshPly(dir_ / "mesh.ply", m, Provenance{"test", "", ""});
   r = RunProgram("build-gvd", {"--udf", "shape:sphere", "-i", dir_ / "mesh.ply", "-o", dir_ / "thick.ply"});
   EXPECT_EQ(r.exit_code, 3) << r.err;
-  // Unknown dual rule: a usage error.
+  // A bad option value: a usage error.
   r = RunProgram("build-gvd", {"--udf", "shape:sphere", "-i", dir_ / "empty.ply", "-o", dir_ / "thick.ply",
-                               "--dual-rule", "nope"});
+                               "--knn", "1"});
   EXPECT_EQ(r.exit_code, 2) << r.err;
   EXPECT_FALSE(test::Exists(dir_ / "thick.ply"));
   EXPECT_FALSE(test::Exists(dir_ / "labels.ply"));

@@ -220,20 +220,41 @@ GvdResult BuildGvd(const Udf& udf, const SeedCloud& seeds, const BuildGvdOptions
   udf.Evaluate(node, node_d, node_n);
 
   // 3. kNN graph, undirected, pruned.
+  monitor.Debug("node gradients evaluated");
   int kk = 0;
   const std::vector<int> knn = KNearest(node, options.knn, &kk, monitor, "kNN graph");
-  std::vector<std::pair<int, int>> edges;
-  edges.reserve(n * static_cast<size_t>(kk));
-  for (size_t i = 0; i < n; ++i)
+  monitor.Debug("kNN queries done");
+  // Undirected edges, each once: (i, j) from i's list when j > i, or when i is not in j's list. No global
+  // sort (it took longer than the queries); the order is by i, then by distance, whatever the threads.
+  auto in_list = [&](size_t owner, int x) {
+    const int* row = knn.data() + owner * static_cast<size_t>(kk);
+    return std::find(row, row + kk, x) != row + kk;
+  };
+  std::vector<size_t> edge_begin(n + 1, 0);
+#pragma omp parallel for schedule(static)
+  for (long li = 0; li < static_cast<long>(n); ++li) {
+    const size_t i = static_cast<size_t>(li);
+    size_t count = 0;
     for (int j = 0; j < kk; ++j) {
       const int o = knn[i * static_cast<size_t>(kk) + static_cast<size_t>(j)];
-      if (o < 0) continue;
-      const int a = static_cast<int>(i);
-      edges.emplace_back(std::min(a, o), std::max(a, o));
+      if (o >= 0 && (o > static_cast<int>(i) || !in_list(static_cast<size_t>(o), static_cast<int>(i)))) ++count;
     }
-  std::sort(edges.begin(), edges.end());
-  edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
+    edge_begin[i + 1] = count;
+  }
+  for (size_t i = 0; i < n; ++i) edge_begin[i + 1] += edge_begin[i];
+  std::vector<std::pair<int, int>> edges(edge_begin[n]);
+#pragma omp parallel for schedule(static)
+  for (long li = 0; li < static_cast<long>(n); ++li) {
+    const size_t i = static_cast<size_t>(li);
+    size_t at = edge_begin[i];
+    for (int j = 0; j < kk; ++j) {
+      const int o = knn[i * static_cast<size_t>(kk) + static_cast<size_t>(j)];
+      if (o >= 0 && (o > static_cast<int>(i) || !in_list(static_cast<size_t>(o), static_cast<int>(i))))
+        edges[at++] = {std::min(static_cast<int>(i), o), std::max(static_cast<int>(i), o)};
+    }
+  }
   stats.edges_knn = edges.size();
+  monitor.Debug("undirected edges listed");
   std::vector<Vec3> mid(edges.size());
 #pragma omp parallel for schedule(static)
   for (long e = 0; e < static_cast<long>(edges.size()); ++e) {
@@ -243,6 +264,7 @@ GvdResult BuildGvd(const Udf& udf, const SeedCloud& seeds, const BuildGvdOptions
   std::vector<double> mid_d;
   std::vector<Vec3> mid_n;
   udf.Evaluate(mid, mid_d, mid_n);
+  monitor.Debug("midpoints evaluated");
   std::vector<Vec3>().swap(mid);
   std::vector<Vec3>().swap(mid_n);
   const double eps_udf = options.eps_udf_rel * diag;
@@ -269,7 +291,7 @@ GvdResult BuildGvd(const Udf& udf, const SeedCloud& seeds, const BuildGvdOptions
   }
   stats.edges_pruned_udf = pruned_udf;
   stats.edges_pruned_grad = pruned_grad;
-  // Adjacency in CSR form; neighbour lists come out sorted because `edges` is.
+  // Adjacency in CSR form, each neighbour list sorted.
   std::vector<size_t> offset(n + 1, 0);
   for (size_t e = 0; e < edges.size(); ++e)
     if (keep[e]) {
@@ -329,29 +351,6 @@ GvdResult BuildGvd(const Udf& udf, const SeedCloud& seeds, const BuildGvdOptions
 
   // 5. Dual triangles. Per thread lists, then one sort: the result does not depend on the scheduling.
   std::vector<std::vector<Tri>> per_thread(static_cast<size_t>(omp_get_max_threads()));
-  auto neighbour_labels = [&](size_t u, std::vector<int>& out) {
-    for (size_t a = offset[u]; a < offset[u + 1]; ++a) out.push_back(label[static_cast<size_t>(adj[a])]);
-  };
-  auto emit = [](int i, int j, std::vector<int>& others, std::vector<Tri>& out) {
-    std::sort(others.begin(), others.end());
-    others.erase(std::unique(others.begin(), others.end()), others.end());
-    others.erase(std::remove_if(others.begin(), others.end(), [&](int l) { return l < 0 || l == i || l == j; }),
-                 others.end());
-    if (j >= 0) {
-      for (int k : others) {
-        Tri t{i, j, k};
-        std::sort(t.begin(), t.end());
-        out.push_back(t);
-      }
-      return;
-    }
-    for (size_t p = 0; p < others.size(); ++p)
-      for (size_t q = p + 1; q < others.size(); ++q) {
-        Tri t{i, others[p], others[q]};
-        std::sort(t.begin(), t.end());
-        out.push_back(t);
-      }
-  };
 #pragma omp parallel
   {
     std::vector<Tri>& out = per_thread[static_cast<size_t>(omp_get_thread_num())];
@@ -361,24 +360,19 @@ GvdResult BuildGvd(const Udf& udf, const SeedCloud& seeds, const BuildGvdOptions
       const size_t u = static_cast<size_t>(li);
       const int i = label[u];
       if (i < 0) continue;
-      // The paper's rule: u (label i) has neighbours labelled j and k.
       others.clear();
-      neighbour_labels(u, others);
-      emit(i, -1, others, out);
-      if (options.dual_rule != DualRule::kEdge) continue;
-      // The edge rule adds, for every graph edge (u, v) across a region border (labels i != j), the labels k
-      // seen by the neighbours of u or v: a junction of three regions is then found even where the samples
-      // leave a gap at it, which a lone sample's neighbourhood misses (holes in the mesh). It only adds
-      // triangles near junctions, which the thinning removes where they are extra.
       for (size_t a = offset[u]; a < offset[u + 1]; ++a) {
-        const size_t v = static_cast<size_t>(adj[a]);
-        const int j = label[v];
-        if (j < 0 || j == i) continue;
-        others.clear();
-        neighbour_labels(u, others);
-        neighbour_labels(v, others);
-        emit(i, j, others, out);
+        const int l = label[static_cast<size_t>(adj[a])];
+        if (l >= 0 && l != i) others.push_back(l);
       }
+      std::sort(others.begin(), others.end());
+      others.erase(std::unique(others.begin(), others.end()), others.end());
+      for (size_t p = 0; p < others.size(); ++p)
+        for (size_t q = p + 1; q < others.size(); ++q) {
+          Tri t{i, others[p], others[q]};
+          std::sort(t.begin(), t.end());
+          out.push_back(t);
+        }
     }
   }
   std::vector<Tri>& faces = result.thick.faces;

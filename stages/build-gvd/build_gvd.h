@@ -14,17 +14,11 @@
 
 namespace voroudf {
 
-/// Which samples make a dual triangle (i, j, k) (see BuildGvd, step 5).
-enum class DualRule {
-  kSample,  ///< the paper's: a sample labelled i has graph neighbours labelled j and k
-  kEdge,    ///< also: a graph edge between labels i and j has an end with a neighbour labelled k
-};
-
 struct BuildGvdOptions {
   /// Dense samples drawn per seed before projection (--samples-per-seed). The kNN graph spans about
   /// sqrt(knn / samples_per_seed) seed spacings, and the wider it is, the more spurious 4-label junctions
   /// (flat tetrahedra for thin-mesh) appear; 100 keeps it near a third of a spacing at ~1 s for 3k seeds.
-  double samples_per_seed = 100.0;
+  double samples_per_seed = 200.0;
   /// Fraction of the dense samples drawn uniformly in the domain box (--space-fraction); the rest are drawn
   /// in balls around the seeds. Box samples project preferentially onto sharp edges, corners and open
   /// boundaries (whole wedges of space project onto them), which is where the graph must connect sheets;
@@ -37,10 +31,7 @@ struct BuildGvdOptions {
   /// An edge is pruned when the UDF at its midpoint exceeds eps_udf_rel * domain diagonal (--eps-udf-rel).
   double eps_udf_rel = 2e-3;
   /// An edge is pruned when |cos(edge, gradient)| at either endpoint exceeds this (--eps-grad).
-  double eps_grad = 0.9;
-  /// Dual triangle rule (--dual-rule sample|edge): the paper's, or a superset that also looks across region
-  /// borders (more triangles near junctions, for sparse samples).
-  DualRule dual_rule = DualRule::kSample;
+  double eps_grad = 0.97;
   /// Adds the triangle of three single-face thick-mesh edges that form a cycle: a junction of three regions
   /// that no sample saw (--close-skipped-junctions; BuildGvd step 6).
   bool close_skipped_junctions = true;

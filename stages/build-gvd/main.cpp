@@ -7,7 +7,6 @@
 int main(int argc, char** argv) {
   voroudf::BuildGvdOptions options;
   std::string udf_spec, input, output, labels;
-  std::string dual_rule = "sample";
   bool ascii = false, graph = false;
 
   voroudf::StageCli cli("build-gvd",
@@ -27,17 +26,12 @@ int main(int argc, char** argv) {
   app.add_option("--knn", options.knn, "neighbours per sample in the kNN graph");
   app.add_option("--eps-udf-rel", options.eps_udf_rel, "prune edges with midpoint UDF above this x diagonal");
   app.add_option("--eps-grad", options.eps_grad, "prune edges with |cos(edge, gradient)| above this at an end");
-  app.add_option("--dual-rule", dual_rule, "sample: the paper's rule; edge: also across region borders")
-      ->check(CLI::IsMember({"sample", "edge"}));
   app.add_option("--close-skipped-junctions", options.close_skipped_junctions,
                  "add the triangle of 3 single-face edges forming a cycle (a junction no sample saw)");
   app.add_option("--proj-tol-rel", options.proj_tol_rel, "projection tolerance on d, relative to the diagonal");
   app.add_option("--proj-max-iters", options.proj_max_iters, "projection steps before a sample is dropped");
 
-  return cli.Run(argc, argv, [&] {
-    options.dual_rule = dual_rule == "edge" ? voroudf::DualRule::kEdge : voroudf::DualRule::kSample;
-    options.Check();
-  }, [&](voroudf::Monitor& monitor) {
+  return cli.Run(argc, argv, [&] { options.Check(); }, [&](voroudf::Monitor& monitor) {
     const auto udf = voroudf::OpenUdf(udf_spec, cli.udf_options());
     monitor.Info("UDF: " + udf->Describe());
     const voroudf::SeedCloud seeds = voroudf::ReadSeeds(input);
