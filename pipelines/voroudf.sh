@@ -1,13 +1,27 @@
 #!/usr/bin/env bash
-# The whole chain for one shape (sample-seeds -> optimize-seeds -> build-gvd -> thin-mesh); every intermediate
-# file is kept in DIR so each stage can be inspected.
-# Usage: pipelines/voroudf.sh --udf SPEC -o DIR [--count N] [--seed S] [--threads T]
+# The whole chain for one shape: sample-seeds -> optimize-seeds -> build-gvd -> thin-mesh [-> evaluate].
+# Every intermediate file is kept in DIR so each stage can be opened in a viewer; DIR/timings.tsv has the
+# wall seconds of each stage.
+#
+# Usage: pipelines/voroudf.sh --udf SPEC -o DIR [--count N] [--seed S] [--threads T] [--reference MESH]
+#            [--sample-seeds "ARGS"] [--optimize-seeds "ARGS"] [--build-gvd "ARGS"] [--thin-mesh "ARGS"]
+#            [--evaluate "ARGS"]
+#   --STAGE "ARGS"  extra options for that stage (split on spaces), e.g. --optimize-seeds "--gamma 5"
+#   --reference     also run evaluate against this mesh -> DIR/metrics.json
+# Swap a stage for your own program with VOROUDF_<STAGE>=command (e.g. VOROUDF_OPTIMIZE_SEEDS=my-opt):
+# it is called with the same options and files.
 set -euo pipefail
 ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 BIN=${VOROUDF_BIN:-$ROOT/build/bin}
+SAMPLE_SEEDS=${VOROUDF_SAMPLE_SEEDS:-$BIN/sample-seeds}
+OPTIMIZE_SEEDS=${VOROUDF_OPTIMIZE_SEEDS:-$BIN/optimize-seeds}
+BUILD_GVD=${VOROUDF_BUILD_GVD:-$BIN/build-gvd}
+THIN_MESH=${VOROUDF_THIN_MESH:-$BIN/thin-mesh}
+EVALUATE=${VOROUDF_EVALUATE:-$BIN/evaluate}
 
-usage() { echo "usage: $0 --udf SPEC -o DIR [--count N] [--seed S] [--threads T]" >&2; exit 2; }
-UDF="" OUT="" COUNT=3000 SEED=0 THREADS=0
+usage() { sed -n '5,12p' "${BASH_SOURCE[0]}" | sed 's/^# \{0,1\}//' >&2; exit "${1:-2}"; }
+UDF="" OUT="" COUNT=3000 SEED=0 THREADS=0 REF=""
+A_SAMPLE="" A_OPT="" A_GVD="" A_THIN="" A_EVAL=""
 while (($#)); do
   case "$1" in
     --udf) UDF=$2; shift 2 ;;
@@ -15,23 +29,45 @@ while (($#)); do
     --count) COUNT=$2; shift 2 ;;
     --seed) SEED=$2; shift 2 ;;
     --threads) THREADS=$2; shift 2 ;;
-    -h|--help) usage ;;
+    --reference) REF=$2; shift 2 ;;
+    --sample-seeds) A_SAMPLE=$2; shift 2 ;;
+    --optimize-seeds) A_OPT=$2; shift 2 ;;
+    --build-gvd) A_GVD=$2; shift 2 ;;
+    --thin-mesh) A_THIN=$2; shift 2 ;;
+    --evaluate) A_EVAL=$2; shift 2 ;;
+    -h|--help) usage 0 ;;
     *) echo "$0: unknown option '$1'" >&2; usage ;;
   esac
 done
 [ -n "$UDF" ] && [ -n "$OUT" ] || usage
 mkdir -p "$OUT"
+: > "$OUT/timings.tsv"
 
-run() { echo "+ $*" >&2; "$@"; }
-run "$BIN/sample-seeds" --udf "$UDF" --count "$COUNT" --seed "$SEED" --threads "$THREADS" -o "$OUT/seeds0.ply"
-if [ -x "$BIN/optimize-seeds" ]; then
-  run "$BIN/optimize-seeds" --udf "$UDF" --seed "$SEED" --threads "$THREADS" -i "$OUT/seeds0.ply" -o "$OUT/seeds.ply"
-else
-  echo "$0: warning: $BIN/optimize-seeds not found; meshing the unoptimised seeds" >&2
-  cp "$OUT/seeds0.ply" "$OUT/seeds.ply"
+# Echoes the command, runs it, appends "stage<TAB>seconds" to timings.tsv.
+run() {
+  local stage=$1; shift
+  echo "+ $*" >&2
+  local t0 t1
+  t0=$(date +%s.%N)
+  "$@"
+  t1=$(date +%s.%N)
+  awk -v s="$stage" -v a="$t0" -v b="$t1" 'BEGIN { printf "%s\t%.3f\n", s, b - a }' >> "$OUT/timings.tsv"
+}
+
+# shellcheck disable=SC2086  # the per-stage ARGS are meant to be split
+run sample-seeds $SAMPLE_SEEDS --udf "$UDF" --count "$COUNT" --seed "$SEED" --threads "$THREADS" \
+  -o "$OUT/seeds0.ply" $A_SAMPLE
+# shellcheck disable=SC2086
+run optimize-seeds $OPTIMIZE_SEEDS --udf "$UDF" --seed "$SEED" --threads "$THREADS" \
+  -i "$OUT/seeds0.ply" -o "$OUT/seeds.ply" $A_OPT
+# shellcheck disable=SC2086
+run build-gvd $BUILD_GVD --udf "$UDF" --seed "$SEED" --threads "$THREADS" \
+  -i "$OUT/seeds.ply" -o "$OUT/thick.ply" --labels "$OUT/labels.ply" $A_GVD
+# shellcheck disable=SC2086
+run thin-mesh $THIN_MESH --udf "$UDF" --threads "$THREADS" \
+  -i "$OUT/thick.ply" -o "$OUT/mesh.ply" --nm-edges "$OUT/nm-edges.ply" $A_THIN
+if [ -n "$REF" ]; then
+  # shellcheck disable=SC2086
+  run evaluate $EVALUATE -i "$OUT/mesh.ply" --reference "$REF" --threads "$THREADS" -o "$OUT/metrics.json" $A_EVAL
 fi
-run "$BIN/build-gvd" --udf "$UDF" --seed "$SEED" --threads "$THREADS" -i "$OUT/seeds.ply" -o "$OUT/thick.ply" \
-  --labels "$OUT/labels.ply"
-run "$BIN/thin-mesh" --udf "$UDF" --threads "$THREADS" -i "$OUT/thick.ply" -o "$OUT/mesh.ply" \
-  --nm-edges "$OUT/nm-edges.ply"
 echo "mesh: $OUT/mesh.ply (non-manifold edges: $OUT/nm-edges.ply; Voronoi labels: $OUT/labels.ply)" >&2

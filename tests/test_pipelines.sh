@@ -1,0 +1,60 @@
+#!/usr/bin/env bash
+# End-to-end tests of the chained executables through the three drivers: pipelines/voroudf.sh,
+# Makefile.example and pipelines/Snakefile. Usage: test_pipelines.sh BIN_DIR {voroudf-sh|make|snakemake}
+set -euo pipefail
+BIN=$(cd "$1" && pwd)
+WHAT=$2
+ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+TMP=$(mktemp -d)
+trap 'rm -rf "$TMP"' EXIT
+fail() { echo "FAIL: $*" >&2; exit 1; }
+export VOROUDF_BIN=$BIN
+
+case "$WHAT" in
+  voroudf-sh)
+    bash "$ROOT/pipelines/voroudf.sh" --udf shape:sphere -o "$TMP/a" --count 500 --seed 3 2> "$TMP/log"
+    for f in seeds0.ply seeds.ply thick.ply labels.ply mesh.ply nm-edges.ply timings.tsv; do
+      [ -s "$TMP/a/$f" ] || fail "voroudf.sh did not write $f"
+    done
+    [ "$(cut -f1 "$TMP/a/timings.tsv" | tr '\n' ' ')" = "sample-seeds optimize-seeds build-gvd thin-mesh " ] ||
+      fail "timings.tsv: $(cat "$TMP/a/timings.tsv")"
+    grep -q "^+ .*optimize-seeds --udf shape:sphere" "$TMP/log" || fail "commands are not echoed"
+    # The same inputs, options and seed give the same bytes through the whole chain.
+    bash "$ROOT/pipelines/voroudf.sh" --udf shape:sphere -o "$TMP/b" --count 500 --seed 3 2> /dev/null
+    cmp -s "$TMP/a/mesh.ply" "$TMP/b/mesh.ply" || fail "the chain is not deterministic"
+    # A stage swapped for another program (here: one that keeps the seeds as they are).
+    printf '#!/bin/sh\nwhile [ $# -gt 0 ]; do case "$1" in -i) in=$2; shift;; -o) out=$2; shift;; esac; shift; done\ncp "$in" "$out"\n' > "$TMP/keep-seeds"
+    chmod +x "$TMP/keep-seeds"
+    VOROUDF_OPTIMIZE_SEEDS="$TMP/keep-seeds" bash "$ROOT/pipelines/voroudf.sh" --udf shape:sphere -o "$TMP/c" \
+      --count 300 2> /dev/null
+    cmp -s "$TMP/c/seeds0.ply" "$TMP/c/seeds.ply" || fail "the swapped stage was not used"
+    [ -s "$TMP/c/mesh.ply" ] || fail "no mesh after swapping a stage"
+    # A failing stage stops the chain with its exit code.
+    set +e
+    bash "$ROOT/pipelines/voroudf.sh" --udf shape:nope -o "$TMP/d" 2> /dev/null
+    rc=$?
+    set -e
+    [ "$rc" = 3 ] || fail "a bad --udf should end the chain with exit 3, got $rc"
+    [ ! -e "$TMP/d/seeds0.ply" ] || fail "a failed stage left a file"
+    ;;
+  make)
+    make -s -f "$ROOT/Makefile.example" -C "$TMP" -j2 VOROUDF_BIN="$BIN" SHAPES="sphere disc" COUNT=400 OUT=out \
+      > "$TMP/log" 2>&1 || { cat "$TMP/log"; fail "make failed"; }
+    for s in sphere disc; do [ -s "$TMP/out/$s/mesh.ply" ] || fail "make did not build $s"; done
+    # A folder of reference meshes: the chain plus evaluate for each.
+    mkdir -p "$TMP/data"
+    cp "$TMP/out/sphere/mesh.ply" "$TMP/data/ball.ply"
+    make -s -f "$ROOT/Makefile.example" -C "$TMP" -j2 VOROUDF_BIN="$BIN" DATA=data COUNT=400 OUT=meshes \
+      > "$TMP/log" 2>&1 || { cat "$TMP/log"; fail "make over a folder failed"; }
+    grep -q '"cd_x1e3"' "$TMP/meshes/ball/metrics.json" || fail "no metrics for the folder's mesh"
+    ;;
+  snakemake)
+    command -v snakemake > /dev/null || fail "snakemake is not installed (pipelines/setup.sh installs it)"
+    (cd "$TMP" && snakemake -s "$ROOT/pipelines/Snakefile" --cores 2 --quiet \
+      --config shapes=sphere,torus out=snake count=400 bin="$BIN" > "$TMP/log" 2>&1) ||
+      { cat "$TMP/log"; fail "snakemake failed"; }
+    for s in sphere torus; do [ -s "$TMP/snake/$s/mesh.ply" ] || fail "snakemake did not build $s"; done
+    ;;
+  *) fail "unknown test '$WHAT'" ;;
+esac
+echo "ok: $WHAT"
