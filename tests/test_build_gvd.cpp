@@ -73,7 +73,7 @@ TEST(BuildGvd, LabelsAreTheGeodesicallyNearestSeedOnTheSphere) {
   EXPECT_LT(worst_ratio, 1.4);  // zigzag of a sparse (6k samples) kNN graph
 }
 
-TEST(BuildGvd, SeedsLabelThemselvesAndTheDualOfFewSeedsOnASphereIsClosed) {
+TEST(BuildGvd, SeedsLabelThemselvesAndEveryDualTriangleIsDistinct) {
   const auto udf = MakeShape("sphere");
   const SeedCloud seeds = Seeds(*udf, 200);
   const GvdResult r = BuildGvd(*udf, seeds, BuildGvdOptions{}, true, Monitor::Null());
