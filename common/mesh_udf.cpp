@@ -8,6 +8,7 @@
 #include <limits>
 #include <sstream>
 
+#include "common/morton.h"
 #include "common/errors.h"
 #include "common/udf_spec.h"
 #include "formats/mesh_io.h"
@@ -69,41 +70,13 @@ void MeshUdf::EvaluateChunk(const Vec3* points, size_t count, double* distance, 
   }
 }
 
-namespace {
-
-// Interleaves the low 21 bits of x with two zero bits between each (for 63-bit Morton codes).
-uint64_t Spread21(uint64_t x) {
-  x &= 0x1fffff;
-  x = (x | x << 32) & 0x1f00000000ffffull;
-  x = (x | x << 16) & 0x1f0000ff0000ffull;
-  x = (x | x << 8) & 0x100f00f00f00f00full;
-  x = (x | x << 4) & 0x10c30c30c30c30c3ull;
-  x = (x | x << 2) & 0x1249249249249249ull;
-  return x;
-}
-
-}  // namespace
-
 void MeshUdf::Evaluate(const Vec3* points, size_t count, double* distance, Vec3* gradient) const {
   constexpr size_t kSortAbove = 4096;  // below this a batch fits the caches anyway
-  if (count < kSortAbove || count > UINT32_MAX) {
+  if (count < kSortAbove) {
     Udf::Evaluate(points, count, distance, gradient);
     return;
   }
-  const Vec3 lo = domain_.min;
-  const Vec3 scale = Vec3::Constant(double((1 << 21) - 1)).cwiseQuotient(domain_.Extent());
-  std::vector<std::pair<uint64_t, uint32_t>> order(count);
-#pragma omp parallel for schedule(static)
-  for (long i = 0; i < static_cast<long>(count); ++i) {
-    uint64_t key = 0;
-    if (points[i].allFinite()) {
-      const Vec3 q = ((points[i] - lo).cwiseProduct(scale)).cwiseMax(0.0).cwiseMin(double((1 << 21) - 1));
-      key = Spread21(static_cast<uint64_t>(q.x())) | Spread21(static_cast<uint64_t>(q.y())) << 1 |
-            Spread21(static_cast<uint64_t>(q.z())) << 2;
-    }
-    order[i] = {key, static_cast<uint32_t>(i)};
-  }
-  std::sort(order.begin(), order.end());
+  const std::vector<size_t> order = MortonOrder(points, count, domain_);
   constexpr size_t kChunk = 256;
   const long chunks = static_cast<long>((count + kChunk - 1) / kChunk);
 #pragma omp parallel for schedule(dynamic, 4)
@@ -111,9 +84,9 @@ void MeshUdf::Evaluate(const Vec3* points, size_t count, double* distance, Vec3*
     const size_t begin = static_cast<size_t>(c) * kChunk, end = std::min(count, begin + kChunk);
     Vec3 p[kChunk], g[kChunk];
     double d[kChunk];
-    for (size_t i = begin; i < end; ++i) p[i - begin] = points[order[i].second];
+    for (size_t i = begin; i < end; ++i) p[i - begin] = points[order[i]];
     EvaluateChunk(p, end - begin, d, g);
-    for (size_t i = begin; i < end; ++i) distance[order[i].second] = d[i - begin], gradient[order[i].second] = g[i - begin];
+    for (size_t i = begin; i < end; ++i) distance[order[i]] = d[i - begin], gradient[order[i]] = g[i - begin];
   }
 }
 
