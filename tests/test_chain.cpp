@@ -2,7 +2,8 @@
 // and properties of the final mesh computed here (closedness, Euler characteristic, distance to the surface,
 // triangle quality, sharp corners, non-manifold curves).
 //
-// The sphere test runs the whole chain with the real optimize-seeds (skipped if its executable is not built).
+// The sphere and sphere-disc tests run the whole chain with the real optimize-seeds (skipped if its executable
+// is not built; sphere-disc is disabled, see there).
 // The other shapes use seeds spread by a greedy minimum-distance filter of sample-seeds' output (fast, and
 // independent of the optimiser, which takes ~30 s per shape at 800 seeds); they are DISABLED_ because the
 // meshes do not meet the criteria yet (a few non-manifold folds on flat sheets and at sharp edges, see
@@ -248,14 +249,21 @@ TEST_F(ChainTest, DISABLED_CrossingPlanesKeepTheirNonManifoldLine) {
   ExpectOnSurface(c, "crossing-planes");
 }
 
+// With seeds from an earlier build of optimize-seeds (1000 seeds) this passed: chi 3, 66 branching edges, all
+// within 2e-4 of the equator; with the current optimiser it does not yet (86, some away from it).
 TEST_F(ChainTest, DISABLED_SphereWithInnerDiscKeepsItsEquator) {
-  const Chain c = RunChain(dir_, "sphere-disc", 3000, 0.016);
+  // optimize-seeds snaps seeds onto the equator (rank 2), so the branching edges lie on it.
+  if (!HaveOptimizer()) GTEST_SKIP() << "optimize-seeds is not built";
+  const Chain c = RunChain(dir_, "sphere-disc", 1000, 0.0, true);
   const double diag = MakeShape("sphere-disc")->Domain().Diagonal();
   const double spacing = 0.016 * diag;
   auto dist = [](const Vec3& p) { return std::hypot(std::hypot(p.x(), p.y()) - 0.5, p.z()); };
   auto point = [](double t) { return Vec3(0.5 * std::cos(2 * M_PI * t), 0.5 * std::sin(2 * M_PI * t), 0.0); };
-  ExpectNonManifoldCurve(c, dist, point, c.optimized ? 0.1 * spacing : spacing, 4 * spacing, M_PI, "sphere-disc");
+  ExpectNonManifoldCurve(c, dist, point, 0.1 * spacing, 4 * spacing, M_PI, "sphere-disc");
   EXPECT_EQ(c.topo.boundary_edges, 0u);
+  // Sphere (2) + disc (1) glued along a circle (0): chi = 3; every branching edge has exactly 3 faces.
+  EXPECT_EQ(c.topo.euler, 3);
+  for (size_t e = 0; e < c.edges.edges.size(); ++e) EXPECT_LE(c.edges.faces[e].size(), 3u);
   ExpectOnSurface(c, "sphere-disc");
 }
 
