@@ -167,14 +167,6 @@ TEST(BuildGvd, BadOptionsAndEmptySeedsAreRefused) {
   EXPECT_THROW(BuildGvd(*udf, SeedCloud{}, BuildGvdOptions{}, false, Monitor::Null()), InputError);
 }
 
-TEST(MortonCode, InterleavesTheAxes) {
-  Box box{Vec3(0, 0, 0), Vec3(1, 1, 1)};
-  EXPECT_EQ(MortonCode(Vec3(0, 0, 0), box), 0u);
-  EXPECT_EQ(MortonCode(Vec3(1, 1, 1), box), (1ull << 63) - 1);
-  EXPECT_LT(MortonCode(Vec3(0.49, 0.49, 0.49), box), MortonCode(Vec3(0.51, 0.0, 0.0), box));
-  EXPECT_EQ(MortonCode(Vec3(0.5, 0, 0), box), 1ull << 60);
-}
-
 class BuildGvdExe : public ::testing::Test {
  protected:
   TempDir dir_;

@@ -17,6 +17,7 @@
 
 #include "common/errors.h"
 #include "common/mesh_topology.h"
+#include "common/morton.h"
 #include "common/projection.h"
 #include "common/rng.h"
 
@@ -31,17 +32,6 @@ std::string Format(const char* fmt, ...) {
   std::vsnprintf(buf, sizeof buf, fmt, args);
   va_end(args);
   return buf;
-}
-
-/// Spreads the low 21 bits of x so that two zero bits follow each one.
-uint64_t Spread3(uint64_t x) {
-  x &= 0x1fffff;
-  x = (x | x << 32) & 0x1f00000000ffffull;
-  x = (x | x << 16) & 0x1f0000ff0000ffull;
-  x = (x | x << 8) & 0x100f00f00f00f00full;
-  x = (x | x << 4) & 0x10c30c30c30c30c3ull;
-  x = (x | x << 2) & 0x1249249249249249ull;
-  return x;
 }
 
 /// Exact k nearest neighbours of every point among `points` (itself excluded), k' = min(k, n-1) per point,
@@ -102,18 +92,6 @@ void BuildGvdOptions::Check() const {
   if (!(eps_grad > 0.0 && eps_grad <= 1.0)) throw UsageError("--eps-grad must be in (0, 1]");
   if (!(proj_tol_rel > 0.0 && proj_tol_rel < 0.1)) throw UsageError("--proj-tol-rel must be in (0, 0.1)");
   if (proj_max_iters < 1) throw UsageError("--proj-max-iters must be at least 1");
-}
-
-uint64_t MortonCode(const Vec3& p, const Box& box) {
-  uint64_t code = 0;
-  for (int c = 0; c < 3; ++c) {
-    const double extent = box.max[c] - box.min[c];
-    double t = extent > 0 ? (p[c] - box.min[c]) / extent : 0.0;
-    t = std::min(std::max(t, 0.0), 1.0);
-    const uint64_t q = std::min<uint64_t>(static_cast<uint64_t>(t * 2097152.0), 2097151);
-    code |= Spread3(q) << c;
-  }
-  return code;
 }
 
 GvdResult BuildGvd(const Udf& udf, const SeedCloud& seeds, const BuildGvdOptions& options, bool with_graph,

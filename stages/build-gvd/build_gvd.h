@@ -90,8 +90,4 @@ struct GvdResult {
 GvdResult BuildGvd(const Udf& udf, const SeedCloud& seeds, const BuildGvdOptions& options, bool with_graph,
                    Monitor& monitor);
 
-/// Morton (Z-order) code of `p` in `box`, 21 bits per axis. Sorting points by it puts neighbours in space
-/// near each other in memory, which makes the kd-tree queries about twice as fast (DESIGN.md, measured).
-uint64_t MortonCode(const Vec3& p, const Box& box);
-
 }  // namespace voroudf
