@@ -36,6 +36,7 @@ int main(int argc, char** argv) {
   app.add_option("--l1-tol-rel", o.l1_tol_rel, "L1 step position accuracy (certified by the duality gap), relative");
   app.add_option("--l1-max-steps", o.l1_max_steps, "Newton steps of the L1 step's interior-point solver");
   app.add_option("--move-tol", o.move_tol, "an inner loop moving no seed farther than this many kernel widths ends it");
+  app.add_option("--outer-tol", o.outer_tol, "outer loop ends when the spacing CV improves by less than this, relatively");
   app.add_option("--proj-tol-rel", o.proj_tol_rel, "projection tolerance on d, relative to the diagonal");
   app.add_option("--proj-max-iters", o.proj_max_iters, "projection steps before a move is undone");
 

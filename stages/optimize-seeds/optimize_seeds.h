@@ -27,6 +27,7 @@ struct OptimizeSeedsOptions {
   double l1_tol_rel = 1e-6;       ///< L1 step solved to this position accuracy, relative to the diagonal (--l1-tol-rel)
   int l1_max_steps = 200;         ///< Newton steps of the L1 step's barrier method before it gives up (--l1-max-steps)
   double move_tol = 1e-3;         ///< an inner loop moving no seed farther than move_tol·σ "makes no update" (--move-tol)
+  double outer_tol = 0.02;        ///< outer loop ends when σ does not grow and the spacing CV drops by less than this, relatively (--outer-tol)
   double proj_tol_rel = 1e-5;     ///< projection tolerance on d, relative to the diagonal (as sample-seeds) (--proj-tol-rel)
   int proj_max_iters = 50;        ///< projection steps before a move is undone (--proj-max-iters)
 
@@ -42,6 +43,7 @@ struct OuterIterationReport {
   int inner_rounds = 0;
   double max_inner_move = 0.0;     ///< largest seed displacement in the inner loop (world units)
   double mean_abs_udf = 0.0;
+  double spacing_cv = 0.0;         ///< coefficient of variation of the nearest-neighbour distances
   size_t rank_count[4] = {0, 0, 0, 0};
   double seconds = 0.0;
 };

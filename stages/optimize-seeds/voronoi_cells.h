@@ -14,7 +14,7 @@ namespace voroudf {
 struct CellSamplingOptions {
   int samples_per_cell = 100;    ///< M
   int radius_knn = 6;            ///< k: the cell is bounded by a ball of radius factor × (distance to the k-th nearest seed)
-  double radius_factor = 1.5;
+  double radius_factor = 0.5;    ///< as OptimizeSeedsOptions::cell_radius_factor (the stage default)
   int max_draws_per_sample = 100; ///< rejection budget: at most M × this draws (in the ball's bounding cube) per cell
 };
 
