@@ -53,6 +53,8 @@ CLI::Option* StageCli::AddExtraOutput(const std::string& flag, std::string* path
   return opt;
 }
 
+void StageCli::MarkNonSemantic(const std::string& flag) { non_semantic_.insert(flag); }
+
 CLI::Option* StageCli::AddUdf(std::string* spec) {
   udf_spec_ = spec;
   CLI::Option* opt = app_.add_option(

@@ -29,6 +29,9 @@ class StageCli {
   CLI::Option* AddOutput(std::string* path, const std::string& description);
   /// An extra optional output file (e.g. --labels); checked like -o when given.
   CLI::Option* AddExtraOutput(const std::string& flag, std::string* path, const std::string& description);
+  /// Leaves an already added option (by its long name, e.g. "--trace") out of the provenance's option list:
+  /// for options that do not change the results, such as debugging output.
+  void MarkNonSemantic(const std::string& flag);
   /// --udf SPEC (required) plus the source options --udf-box and --udf-timeout.
   CLI::Option* AddUdf(std::string* spec);
   /// --seed for the random number generator.

@@ -572,6 +572,12 @@ TEST_F(OptimizeSeedsExe, WritesSeedsOnTheSurfaceWithRanksAndATrace) {
   for (const char* name : {"iter-001.ply", "iter-002.ply", "iter-003.ply"})
     EXPECT_EQ(ReadSeeds(dir_ / ("trace/" + std::string(name))).size(), 300u) << name;
   EXPECT_NE(test::ReadBytes(out).find("comment stage optimize-seeds"), std::string::npos);
+  // --trace is debugging output: not in the provenance, and the output is the same bytes without it.
+  EXPECT_EQ(test::ReadBytes(out).find("--trace"), std::string::npos);
+  const std::string plain = dir_ / "plain.ply";
+  const auto r2 = RunProgram("optimize-seeds", Args(seeds0_, plain));
+  ASSERT_EQ(r2.exit_code, 0) << r2.err;
+  EXPECT_EQ(test::ReadBytes(out), test::ReadBytes(plain));
 }
 
 TEST_F(OptimizeSeedsExe, SameSeedSameBytesWhateverTheThreadCount) {

@@ -21,6 +21,7 @@ int main(int argc, char** argv) {
   cli.AddAscii(&ascii);
   auto& app = cli.app();
   app.add_option("--trace", trace_dir, "directory for the seeds after every outer iteration (iter-NNN.ply)");
+  cli.MarkNonSemantic("--trace");  // debugging output only: not part of the provenance
   app.add_option("-m,--samples-per-cell", o.samples_per_cell, "M: samples per Voronoi cell");
   app.add_option("--gamma", o.gamma, "proximity weight of the L1 step (lengths relative to the diagonal)");
   app.add_option("--delta", o.delta, "inner loop stops when the projected gradient changes by less than this");
