@@ -519,6 +519,35 @@ TEST(OptimizeSeeds, SphereWithDiscRankTwoSeedsOnTheEquator) {
   ExpectRankTwoOnFeatures("sphere-disc", equator, equator, 20, 2.0);
 }
 
+// The stopping rules fire before the caps: the inner loop at the first round whose projected gradient
+// does not decrease by δ, the outer loop at the first iteration where σ stops growing and the spacing
+// CV improves by less than outer_tol (and not before it).
+TEST(OptimizeSeeds, StoppingRulesEndTheLoopsBeforeTheirCaps) {
+  const auto sphere = MakeShape("sphere");
+  const SeedCloud in = Initial(*sphere, 500, 5);
+  OptimizeSeedsOptions options;
+  options.seed = 2;
+  options.max_outer_iters = 20;
+  std::vector<OuterIterationReport> reports;
+  OptimizeSeeds(*sphere, in, options, Monitor::Null(),
+                [&](const OuterIterationReport& r, const SeedCloud&) { reports.push_back(r); });
+  ASSERT_GE(reports.size(), 2u);
+  EXPECT_LT(reports.size(), 20u) << "outer loop ran to its cap";
+  size_t inner_before_cap = 0;
+  for (const auto& r : reports) inner_before_cap += r.inner_rounds < options.max_inner_iters;
+  EXPECT_GT(inner_before_cap, 0u) << "every inner loop ran to its cap";
+  auto no_update = [&](size_t k) {
+    return reports[k].sigma <= reports[k - 1].sigma * (1 + options.outer_tol) &&
+           reports[k].spacing_cv >= reports[k - 1].spacing_cv * (1 - options.outer_tol);
+  };
+  const size_t last = reports.size() - 1;
+  if (reports.size() < 20u) {
+    EXPECT_TRUE(no_update(last) || reports[last].max_inner_move <= options.move_tol * reports[last].sigma);
+    for (size_t k = 1; k < last; ++k) EXPECT_FALSE(no_update(k)) << "should have stopped after iteration " << k + 1;
+  }
+  EXPECT_LT(reports[last].spacing_cv, NearestNeighbourCv(in.position) / 2.0);
+}
+
 TEST(OptimizeSeeds, BadOptionsAndInputs) {
   OptimizeSeedsOptions o;
   o.gamma = 0;
