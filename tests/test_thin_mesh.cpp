@@ -214,10 +214,43 @@ TEST(ThinMesh, NonManifoldEdgesAreExtracted) {
   EXPECT_EQ(nm.vertices[1], m.vertices[1]);
 }
 
+/// A flat fan on edge 0-1 with a third face 0-1-4 on the same side as 0-1-2 (a fold), or, when `fin`, with
+/// vertex 4 lifted out of the plane (a branching of the surface).
+TriangleMesh Fold(bool fin) {
+  TriangleMesh m;
+  m.vertices = {{0, 0, 0}, {0.2, 0, 0}, {0.1, 0.2, 0}, {0.1, -0.2, 0}, {0.1, fin ? 0.0 : 0.08, fin ? 0.2 : 0.0}};
+  m.faces = {{0, 1, 2}, {1, 0, 3}, {0, 1, 4}};
+  return m;
+}
+
+TEST(ThinMesh, AFlatFoldIsRetriangulatedWithoutOpeningTheSurface) {
+  ThinMeshStats st;
+  const TriangleMesh out = ThinMesh(*MakeShape("disc"), Fold(false), MinFaces(0), Monitor::Null(), &st);
+  EXPECT_EQ(st.folds_retriangulated, 1u);
+  const TopologyStats topo = ComputeTopology(out);
+  EXPECT_EQ(topo.nonmanifold_edges, 0u);
+  EXPECT_EQ(topo.boundary_edges, 4u);  // the fan's outline 0-2-1-3
+  EXPECT_EQ(topo.euler, 1);
+  EXPECT_EQ(out.faces.size(), 4u);  // vertex 4 is now inside the fan: 0-1-4, 0-4-2, 4-1-2 and 0-1-3
+}
+
+TEST(ThinMesh, ABranchingEdgeIsNotAFold) {
+  ThinMeshStats st;
+  const TriangleMesh out = ThinMesh(*MakeShape("disc"), Fold(true), MinFaces(0), Monitor::Null(), &st);
+  EXPECT_EQ(st.folds_retriangulated, 0u);
+  EXPECT_EQ(ComputeTopology(out).nonmanifold_edges, 1u);
+  ThinMeshOptions off = MinFaces(0);
+  off.fold_flatness_deg = 0;
+  EXPECT_EQ(ComputeTopology(ThinMesh(*MakeShape("disc"), Fold(false), off, Monitor::Null())).nonmanifold_edges, 1u);
+}
+
 TEST(ThinMesh, BadOptionsAreUsageErrors) {
   ThinMeshOptions o;
   o.degenerate_quality = -1;
   EXPECT_THROW(o.Check(), UsageError);
+  ThinMeshOptions f;
+  f.fold_flatness_deg = 90;
+  EXPECT_THROW(f.Check(), UsageError);
 }
 
 class ThinMeshExe : public ::testing::Test {

@@ -21,6 +21,8 @@ int main(int argc, char** argv) {
                  "components with fewer faces are removed (unless that opens a hole)");
   app.add_option("--degenerate-quality", options.degenerate_quality,
                  "faces with triangle quality below this are dropped as degenerate (0: only zero area)");
+  app.add_option("--fold-flatness", options.fold_flatness_deg,
+                 "re-triangulate faces around a non-manifold edge within this angle (deg) of a plane (0: off)");
 
   return cli.Run(argc, argv, [&] { options.Check(); }, [&](voroudf::Monitor& monitor) {
     const auto udf = voroudf::OpenUdf(udf_spec, cli.udf_options());

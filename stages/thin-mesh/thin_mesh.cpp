@@ -1,8 +1,11 @@
 #include "stages/thin-mesh/thin_mesh.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
+#include <map>
 #include <numeric>
+#include <set>
 #include <unordered_map>
 #include <unordered_set>
 
@@ -255,12 +258,147 @@ class Thinner {
   std::unordered_map<Tri, int, TriHash> by_vertices_;
 };
 
+/// Step 4: re-triangulates flat folds. For each non-manifold edge (a, b), in edge order, the patch of faces
+/// touching a or b is replaced by the 2-D Delaunay triangulation of its vertices projected on the patch's
+/// best-fit plane, keeping the triangles inside the projected patch, when every patch face is within
+/// acos(min_cos) of that plane (a fold on a sheet, not a branching of the surface) and the replacement
+/// lowers the number of non-manifold edges without adding boundary edges. Returns the patches replaced.
+size_t RetriangulateFlatFolds(const std::vector<Vec3>& vertices, std::vector<Tri>& faces, double min_cos,
+                              double min_quality) {
+  size_t replaced = 0;
+  for (int round = 0; round < 8; ++round) {
+    std::map<std::pair<int, int>, int> valence;
+    auto key = [](int u, int v) { return std::make_pair(std::min(u, v), std::max(u, v)); };
+    for (const Tri& t : faces)
+      for (int k = 0; k < 3; ++k) ++valence[key(t[static_cast<size_t>(k)], t[static_cast<size_t>((k + 1) % 3)])];
+    std::vector<std::pair<int, int>> nm;
+    for (const auto& [e, c] : valence)
+      if (c >= 3) nm.push_back(e);
+    if (nm.empty()) break;
+    std::vector<char> touched(vertices.size(), 0);
+    std::vector<char> gone(faces.size(), 0);
+    std::vector<Tri> added;
+    std::set<Tri> existing;
+    for (const Tri& t : faces) existing.insert(Sorted(t));
+    size_t this_round = 0;
+    for (const auto& [a, b] : nm) {
+      std::vector<size_t> patch;
+      for (size_t f = 0; f < faces.size(); ++f) {
+        if (gone[f]) continue;
+        const Tri& t = faces[f];
+        for (int v : t)
+          if (v == a || v == b) {
+            patch.push_back(f);
+            break;
+          }
+      }
+      std::vector<int> pv;
+      bool fresh = true;
+      for (size_t f : patch)
+        for (int v : faces[f]) {
+          pv.push_back(v);
+          fresh = fresh && !touched[static_cast<size_t>(v)];
+        }
+      if (!fresh) continue;  // one patch per neighbourhood and round: the valences below are the round's
+      std::sort(pv.begin(), pv.end());
+      pv.erase(std::unique(pv.begin(), pv.end()), pv.end());
+      if (pv.size() > 24) continue;
+      auto normal = [&](const Tri& t) {
+        const Vec3& p0 = vertices[static_cast<size_t>(t[0])];
+        return Vec3((vertices[static_cast<size_t>(t[1])] - p0).cross(vertices[static_cast<size_t>(t[2])] - p0));
+      };
+      Vec3 ref = normal(faces[patch[0]]).normalized(), mean = Vec3::Zero();
+      for (size_t f : patch) {
+        const Vec3 nf = normal(faces[f]);
+        mean += nf.dot(ref) >= 0.0 ? nf : Vec3(-nf);
+      }
+      if (!(mean.norm() > 0.0)) continue;
+      mean.normalize();
+      bool flat = true;
+      for (size_t f : patch) flat = flat && std::abs(normal(faces[f]).normalized().dot(mean)) >= min_cos;
+      if (!flat) continue;
+      const Vec3 u = (std::abs(mean.x()) < 0.9 ? Vec3::UnitX() : Vec3::UnitY()).cross(mean).normalized();
+      const Vec3 w = mean.cross(u);
+      std::unordered_map<int, Eigen::Vector2d> q;
+      for (int v : pv) q[v] = Eigen::Vector2d(vertices[static_cast<size_t>(v)].dot(u), vertices[static_cast<size_t>(v)].dot(w));
+      auto cross2 = [](const Eigen::Vector2d& o, const Eigen::Vector2d& x, const Eigen::Vector2d& y) {
+        return (x - o).x() * (y - o).y() - (x - o).y() * (y - o).x();
+      };
+      auto inside_patch = [&](const Eigen::Vector2d& c) {
+        for (size_t f : patch) {
+          const Tri& t = faces[f];
+          const double d0 = cross2(q[t[0]], q[t[1]], c), d1 = cross2(q[t[1]], q[t[2]], c), d2 = cross2(q[t[2]], q[t[0]], c);
+          if ((d0 >= 0 && d1 >= 0 && d2 >= 0) || (d0 <= 0 && d1 <= 0 && d2 <= 0)) return true;
+        }
+        return false;
+      };
+      std::vector<Tri> tris;
+      for (size_t i = 0; i < pv.size(); ++i)
+        for (size_t j = i + 1; j < pv.size(); ++j)
+          for (size_t k = j + 1; k < pv.size(); ++k) {
+            const Eigen::Vector2d &A = q[pv[i]], &B = q[pv[j]], &C = q[pv[k]];
+            const double area2 = cross2(A, B, C);
+            if (std::abs(area2) < 1e-12 * ((B - A).squaredNorm() + (C - A).squaredNorm())) continue;
+            bool empty = true;
+            for (size_t m = 0; m < pv.size() && empty; ++m) {
+              if (m == i || m == j || m == k) continue;
+              const Eigen::Vector2d& D = q[pv[m]];
+              const Eigen::Vector2d a2 = A - D, b2 = B - D, c2 = C - D;
+              const double det = a2.squaredNorm() * (b2.x() * c2.y() - b2.y() * c2.x()) -
+                                 b2.squaredNorm() * (a2.x() * c2.y() - a2.y() * c2.x()) +
+                                 c2.squaredNorm() * (a2.x() * b2.y() - a2.y() * b2.x());
+              if ((area2 > 0 ? det : -det) > 0) empty = false;
+            }
+            if (!empty || !inside_patch((A + B + C) / 3.0)) continue;
+            const double quality = TriangleQuality(vertices[static_cast<size_t>(pv[i])], vertices[static_cast<size_t>(pv[j])],
+                                                   vertices[static_cast<size_t>(pv[k])]);
+            if (quality >= min_quality && quality > 0.0) tris.push_back({pv[i], pv[j], pv[k]});
+          }
+      // Valence change on the patch's edges; accept when non-manifold edges drop and no boundary appears.
+      std::map<std::pair<int, int>, int> delta;
+      for (size_t f : patch)
+        for (int k = 0; k < 3; ++k) --delta[key(faces[f][static_cast<size_t>(k)], faces[f][static_cast<size_t>((k + 1) % 3)])];
+      bool duplicate = false;
+      for (const Tri& t : tris) {
+        for (int k = 0; k < 3; ++k) ++delta[key(t[static_cast<size_t>(k)], t[static_cast<size_t>((k + 1) % 3)])];
+        bool own = false;
+        for (size_t f : patch) own = own || Sorted(faces[f]) == t;
+        duplicate = duplicate || (!own && existing.count(t) > 0);
+      }
+      if (duplicate) continue;
+      int nm_before = 0, nm_after = 0, open_before = 0, open_after = 0;
+      for (const auto& [e, d] : delta) {
+        const auto it = valence.find(e);
+        const int before = it == valence.end() ? 0 : it->second, after = before + d;
+        nm_before += before >= 3;
+        nm_after += after >= 3;
+        open_before += before == 1;
+        open_after += after == 1;
+      }
+      if (!(nm_after < nm_before && open_after <= open_before)) continue;
+      for (size_t f : patch) gone[f] = 1;
+      added.insert(added.end(), tris.begin(), tris.end());
+      for (int v : pv) touched[static_cast<size_t>(v)] = 1;
+      ++this_round;
+    }
+    if (this_round == 0) break;
+    replaced += this_round;
+    std::vector<Tri> next;
+    for (size_t f = 0; f < faces.size(); ++f)
+      if (!gone[f]) next.push_back(faces[f]);
+    next.insert(next.end(), added.begin(), added.end());
+    faces.swap(next);
+  }
+  return replaced;
+}
+
 std::string Count(size_t n, const char* what) { return std::to_string(n) + " " + what; }
 
 }  // namespace
 
 void ThinMeshOptions::Check() const {
   if (min_component_faces > 1000000) throw UsageError("--min-component-faces must be at most 1e6");
+  if (!(fold_flatness_deg >= 0.0 && fold_flatness_deg < 90.0)) throw UsageError("--fold-flatness must be in [0, 90)");
   if (!(degenerate_quality >= 0.0 && degenerate_quality < 0.5))
     throw UsageError("--degenerate-quality must be in [0, 0.5)");
 }
@@ -349,12 +487,21 @@ TriangleMesh ThinMesh(const Udf& udf, const TriangleMesh& thick, const ThinMeshO
     monitor.Warn(Count(st.tetrahedra_left, "closed tetrahedra are left: none of their face pairs shares a manifold edge"));
   if (st.small_components_left > 0)
     monitor.Warn(Count(st.small_components_left, "small components are left: removing them would open a hole"));
-  thinner.OrientComponents();
+  std::vector<Tri> kept;
+  for (size_t f = 0; f < thinner.faces().size(); ++f)
+    if (thinner.alive()[f]) kept.push_back(thinner.faces()[f]);
+  // 4. Flat folds.
+  if (options.fold_flatness_deg > 0.0) {
+    st.folds_retriangulated = RetriangulateFlatFolds(thick.vertices, kept, std::cos(options.fold_flatness_deg * M_PI / 180.0),
+                                                      options.degenerate_quality);
+    monitor.Info(Count(st.folds_retriangulated, "flat folds re-triangulated"));
+  }
+  Thinner oriented(std::move(kept), std::vector<double>());
+  oriented.OrientComponents();
 
   TriangleMesh out;
   out.vertices = thick.vertices;
-  for (size_t f = 0; f < thinner.faces().size(); ++f)
-    if (thinner.alive()[f]) out.faces.push_back(thinner.faces()[f]);
+  out.faces = oriented.faces();
   out = RemoveUnreferencedVertices(out);
   monitor.Info(Count(out.vertices.size(), "vertices, ") + Count(out.faces.size(), "faces out"));
   if (stats_out) *stats_out = st;

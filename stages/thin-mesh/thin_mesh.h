@@ -18,6 +18,11 @@ struct ThinMeshOptions {
   /// longest edge), 1 for equilateral) is below this (--degenerate-quality). Three seeds on one straight
   /// sharp edge give such slivers (quality ~1e-6), as do coincident seeds (0).
   double degenerate_quality = 1e-3;
+  /// Step 4 (--fold-flatness, degrees; 0: off): the faces around a non-manifold edge are re-triangulated (2-D
+  /// Delaunay in their best-fit plane) when all are within this angle of that plane, i.e. the edge is a fold
+  /// of a sheet rather than a branching of the surface, and the result has fewer non-manifold edges and no
+  /// more boundary edges.
+  double fold_flatness_deg = 25.0;
 
   /// Throws UsageError for values that cannot work.
   void Check() const;
@@ -33,6 +38,7 @@ struct ThinMeshStats {
   size_t components_removed = 0;    ///< small components removed
   size_t component_faces_removed = 0;
   size_t small_components_left = 0; ///< small components whose removal would have opened a hole
+  size_t folds_retriangulated = 0;   ///< step 4: patches around flat non-manifold edges replaced
   int rounds = 0;                   ///< rounds of (tetrahedra, components) until nothing changed
 };
 
@@ -50,7 +56,12 @@ struct ThinMeshStats {
 ///     removed when that leaves every one of its non-manifold border edges with 2+ faces (no new hole);
 ///     largest mean centroid UDF first (Fig. 8's rule), repeated until none can go. So isolated small pieces, fins and the sides of residual
 ///     polyhedra ("non-manifold polyhedral artifacts", Sec. 3.4) go, while a surface is never cut open.
-///  3. Steps 1–2 repeat until neither changes the mesh; unreferenced vertices are dropped (order kept).
+///  3. Steps 1–2 repeat until neither changes the mesh.
+///  4. Flat folds: for each non-manifold edge (a, b) whose surrounding faces (those touching a or b) are all
+///     within fold_flatness_deg of their best-fit plane, those faces are replaced by the 2-D Delaunay
+///     triangles of their vertices (projected on that plane) that lie inside the projected patch, when that
+///     lowers the number of non-manifold edges and adds no boundary edge. Branching edges (sheets meeting at
+///     an angle) are not flat and stay. Unreferenced vertices are dropped (order kept).
 ///
 /// \param udf    the field, for the centroid values
 /// \param thick  vertices + faces with valid indices (the caller validates them)
