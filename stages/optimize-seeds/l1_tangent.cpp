@@ -156,19 +156,30 @@ L1TangentSolution SolveL1Tangent(const L1TangentProblem& p, const L1TangentOptio
   std::vector<double> u(m_count), lambda(k_count);
 
   auto barrier = [&](const Vec3& yy, const std::vector<double>& tt, double* value) {
-    double f = p.gamma * yy.squaredNorm(), logs = 0.0;
+    // Σ log s as the log of running products (flushed long before they could under- or overflow): the
+    // line search evaluates this often, and std::log was 12 % of the stage's time (perf, fandisk 3k).
+    double f = p.gamma * yy.squaredNorm(), logs = 0.0, product = 1.0;
+    auto take = [&](double slack) {
+      product *= slack;
+      if (product < 1e-150 || product > 1e150) {
+        logs += std::log(product);
+        product = 1.0;
+      }
+    };
     for (size_t m = 0; m < m_count; ++m) {
       const double rm = p.a[m].dot(yy) - p.b[m];
       const double sp = tt[m] - rm, sm = tt[m] + rm;
       if (!(sp > 0.0 && sm > 0.0)) return false;
       f += weight(m) * tt[m];
-      logs += std::log(sp) + std::log(sm);
+      take(sp);
+      take(sm);
     }
     for (size_t k = 0; k < k_count; ++k) {
       const double sk = p.h[k] - p.c[k].dot(yy);
       if (!(sk > 0.0)) return false;
-      logs += std::log(sk);
+      take(sk);
     }
+    logs += std::log(product);
     *value = tau * f - logs;
     return true;
   };
