@@ -5,10 +5,10 @@
 // The sphere and sphere-disc tests run the whole chain with the real optimize-seeds (skipped if its executable
 // is not built; sphere-disc is disabled, see there).
 // The other shapes use seeds spread by a greedy minimum-distance filter of sample-seeds' output (fast, and
-// independent of the optimiser, which takes ~30 s per shape at 800 seeds). The torus passes since thin-mesh
-// re-triangulates flat folds (step 4); the others are DISABLED_ because the meshes do not meet the issue's
-// criteria yet (see docs/thin-mesh.md "Known limits"). Run them with --gtest_also_run_disabled_tests to see
-// the current state.
+// independent of the optimiser, which takes ~30 s per shape at 800 seeds). The torus, disc and hemisphere
+// pass since thin-mesh re-triangulates flat folds (step 4); the others are DISABLED_ because the meshes do
+// not meet the criteria yet (see docs/thin-mesh.md "Known limits"). Run them with
+// --gtest_also_run_disabled_tests to see the current state.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -168,7 +168,7 @@ TEST_F(ChainTest, TorusKeepsItsHandle) {
   ExpectOnSurface(c, "torus");
 }
 
-TEST_F(ChainTest, DISABLED_DiscAndHemisphereHaveOneBoundaryLoop) {
+TEST_F(ChainTest, DiscAndHemisphereHaveOneBoundaryLoop) {
   for (const std::string shape : {"disc", "hemisphere"}) {
     TempDir dir;
     const Chain c = RunChain(dir, shape, 3000, 0.016);

@@ -66,10 +66,17 @@ TEST(ThinMesh, FlatTetrahedronLosesThePairWithTheHighestCentroidUdf) {
 
 TEST(ThinMesh, OnlyAPairOnAManifoldEdgeGoesWhenTheTetrahedronSitsInASurface) {
   const auto udf = MakeShape("disc");
-  // Heights make abc + acd (sharing the outer edge ac) the highest pair. Alone, that pair goes.
+  // Heights make abc + acd (sharing the outer edge ac) the highest pair. Alone, that pair goes (step 1; step 4
+  // off, see below).
   TriangleMesh tet = Tetrahedron(0.03, 0.0, 0.01, 0.0);
-  const std::set<Tri> alone = SortedFaces(ThinMesh(*udf, tet, MinFaces(1), Monitor::Null()));
+  ThinMeshOptions step1_only = MinFaces(1);
+  step1_only.fold_flatness_deg = 0;
+  const std::set<Tri> alone = SortedFaces(ThinMesh(*udf, tet, step1_only, Monitor::Null()));
   EXPECT_EQ(alone, (std::set<Tri>{{0, 1, 3}, {1, 2, 3}}));
+  // abd and bcd overlap (a and c lie on the same side of bd): a fold, which step 4 re-triangulates into the
+  // quad a-c-b-d split along a diagonal.
+  const std::set<Tri> unfolded = SortedFaces(ThinMesh(*udf, tet, MinFaces(1), Monitor::Null()));
+  EXPECT_EQ(unfolded, (std::set<Tri>{{0, 2, 3}, {1, 2, 3}}));
   // Inside a surface: a fan of faces around the quad a-c-b-d makes every outer edge non-manifold, so only the
   // pairs on the diagonals ab or cd may go; of those abc + abd has the higher UDF.
   TriangleMesh surface = tet;

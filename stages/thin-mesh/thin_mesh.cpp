@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <map>
 #include <numeric>
 #include <set>
@@ -258,6 +259,75 @@ class Thinner {
   std::unordered_map<Tri, int, TriHash> by_vertices_;
 };
 
+/// Ear clipping of the outline of `patch` (its edges used by one patch face, which must form one simple
+/// cycle) in the 2-D coordinates `q`: best ear (triangle quality) first. Empty when that fails.
+std::vector<Tri> EarClip(const std::vector<Vec3>& vertices, const std::vector<size_t>& patch, const std::vector<Tri>& faces,
+                         const std::unordered_map<int, Eigen::Vector2d>& q, double min_quality) {
+  std::map<std::pair<int, int>, int> uses;
+  for (size_t f : patch)
+    for (int k = 0; k < 3; ++k) {
+      const int u = faces[f][static_cast<size_t>(k)], w = faces[f][static_cast<size_t>((k + 1) % 3)];
+      ++uses[{std::min(u, w), std::max(u, w)}];
+    }
+  std::map<int, std::vector<int>> next;
+  for (const auto& [e, c] : uses)
+    if (c == 1) {
+      next[e.first].push_back(e.second);
+      next[e.second].push_back(e.first);
+    }
+  if (next.size() < 3) return {};
+  for (const auto& [v, n] : next)
+    if (n.size() != 2) return {};
+  std::vector<int> poly{next.begin()->first};
+  int prev = -1;
+  for (;;) {
+    const std::vector<int>& n = next[poly.back()];
+    const int nx = n[0] != prev ? n[0] : n[1];
+    prev = poly.back();
+    if (nx == poly.front()) break;
+    poly.push_back(nx);
+    if (poly.size() > next.size()) return {};
+  }
+  if (poly.size() != next.size()) return {};
+  auto at = [&](int v) { return q.at(v); };
+  auto cross2 = [](const Eigen::Vector2d& o, const Eigen::Vector2d& x, const Eigen::Vector2d& y) {
+    return (x - o).x() * (y - o).y() - (x - o).y() * (y - o).x();
+  };
+  double area = 0.0;
+  for (size_t i = 0; i < poly.size(); ++i) area += cross2(Eigen::Vector2d::Zero(), at(poly[i]), at(poly[(i + 1) % poly.size()]));
+  if (area < 0.0) std::reverse(poly.begin(), poly.end());
+  std::vector<Tri> out;
+  while (poly.size() > 3) {
+    size_t best = poly.size();
+    double best_q = -1.0;
+    for (size_t i = 0; i < poly.size(); ++i) {
+      const int p0 = poly[(i + poly.size() - 1) % poly.size()], p1 = poly[i], p2 = poly[(i + 1) % poly.size()];
+      if (!(cross2(at(p0), at(p1), at(p2)) > 0.0)) continue;
+      bool empty = true;
+      for (int v : poly) {
+        if (v == p0 || v == p1 || v == p2) continue;
+        if (cross2(at(p0), at(p1), at(v)) >= 0 && cross2(at(p1), at(p2), at(v)) >= 0 && cross2(at(p2), at(p0), at(v)) >= 0)
+          empty = false;
+      }
+      if (!empty) continue;
+      const double quality = TriangleQuality(vertices[static_cast<size_t>(p0)], vertices[static_cast<size_t>(p1)],
+                                             vertices[static_cast<size_t>(p2)]);
+      if (quality > best_q) {
+        best_q = quality;
+        best = i;
+      }
+    }
+    if (best == poly.size() || !(best_q >= min_quality) || best_q == 0.0) return {};
+    out.push_back(Sorted({poly[(best + poly.size() - 1) % poly.size()], poly[best], poly[(best + 1) % poly.size()]}));
+    poly.erase(poly.begin() + static_cast<long>(best));
+  }
+  const double quality = TriangleQuality(vertices[static_cast<size_t>(poly[0])], vertices[static_cast<size_t>(poly[1])],
+                                         vertices[static_cast<size_t>(poly[2])]);
+  if (!(cross2(at(poly[0]), at(poly[1]), at(poly[2])) > 0.0) || !(quality >= min_quality) || quality == 0.0) return {};
+  out.push_back(Sorted({poly[0], poly[1], poly[2]}));
+  return out;
+}
+
 /// Step 4: re-triangulates flat folds. For each non-manifold edge (a, b), in edge order, the patch of faces
 /// touching a or b is replaced by the 2-D Delaunay triangulation of its vertices projected on the patch's
 /// best-fit plane, keeping the triangles inside the projected patch, when every patch face is within
@@ -265,32 +335,88 @@ class Thinner {
 /// lowers the number of non-manifold edges without adding boundary edges. Returns the patches replaced.
 size_t RetriangulateFlatFolds(const std::vector<Vec3>& vertices, std::vector<Tri>& faces, double min_cos,
                               double min_quality) {
+  using Edge = std::pair<int, int>;
+  auto key = [](int u, int v) { return std::make_pair(std::min(u, v), std::max(u, v)); };
+  auto normal = [&](const Tri& t) {
+    const Vec3& p0 = vertices[static_cast<size_t>(t[0])];
+    return Vec3((vertices[static_cast<size_t>(t[1])] - p0).cross(vertices[static_cast<size_t>(t[2])] - p0));
+  };
+  // Two faces of edge e on the same side of it, nearly coplanar: their third vertices' perpendiculars from
+  // the edge within acos(min_cos).
+  auto folded = [&](const Edge& e, const std::vector<Tri>& fs) {
+    const Vec3& pa = vertices[static_cast<size_t>(e.first)];
+    const Vec3 t = (vertices[static_cast<size_t>(e.second)] - pa).normalized();
+    std::vector<Vec3> perp;
+    for (const Tri& f : fs) {
+      Vec3 v = vertices[static_cast<size_t>(f[0] + f[1] + f[2] - e.first - e.second)] - pa;
+      v -= v.dot(t) * t;
+      perp.push_back(v.norm() > 0.0 ? Vec3(v.normalized()) : v);
+    }
+    for (size_t i = 0; i < perp.size(); ++i)
+      for (size_t j = i + 1; j < perp.size(); ++j)
+        if (perp[i].dot(perp[j]) >= min_cos) return true;
+    return false;
+  };
   size_t replaced = 0;
   for (int round = 0; round < 8; ++round) {
-    std::map<std::pair<int, int>, int> valence;
-    auto key = [](int u, int v) { return std::make_pair(std::min(u, v), std::max(u, v)); };
+    std::map<Edge, std::vector<Tri>> edge_faces;
     for (const Tri& t : faces)
-      for (int k = 0; k < 3; ++k) ++valence[key(t[static_cast<size_t>(k)], t[static_cast<size_t>((k + 1) % 3)])];
-    std::vector<std::pair<int, int>> nm;
-    for (const auto& [e, c] : valence)
-      if (c >= 3) nm.push_back(e);
-    if (nm.empty()) break;
+      for (int k = 0; k < 3; ++k) edge_faces[key(t[static_cast<size_t>(k)], t[static_cast<size_t>((k + 1) % 3)])].push_back(Sorted(t));
+    std::vector<std::pair<Edge, bool>> bad;  // non-manifold edges (true) and folded manifold edges (false)
+    for (const auto& [e, fs] : edge_faces)
+      if (fs.size() >= 3 || (fs.size() == 2 && folded(e, fs))) bad.push_back({e, fs.size() >= 3});
+    if (bad.empty()) break;
     std::vector<char> touched(vertices.size(), 0);
     std::vector<char> gone(faces.size(), 0);
     std::vector<Tri> added;
     std::set<Tri> existing;
     for (const Tri& t : faces) existing.insert(Sorted(t));
     size_t this_round = 0;
-    for (const auto& [a, b] : nm) {
+    // Candidates: every bad edge alone (its two vertices), then every cluster of 3+ vertices joined by bad
+    // edges (a fold can be a whole cycle of folded edges), each with its first edge and whether it has a
+    // non-manifold edge.
+    struct Candidate {
+      std::vector<int> centre;
+      Edge edge;
+      bool is_nm;
+    };
+    std::vector<Candidate> candidates;
+    for (const auto& [edge, is_nm] : bad) candidates.push_back({{edge.first, edge.second}, edge, is_nm});
+    {
+      std::map<int, int> parent;
+      std::function<int(int)> root = [&](int x) { return parent[x] == x ? x : parent[x] = root(parent[x]); };
+      for (const auto& [edge, is_nm] : bad) {
+        parent.emplace(edge.first, edge.first);
+        parent.emplace(edge.second, edge.second);
+      }
+      for (const auto& [edge, is_nm] : bad) {
+        const int ra = root(edge.first), rb = root(edge.second);
+        parent[std::max(ra, rb)] = std::min(ra, rb);
+      }
+      std::map<int, Candidate> clusters;
+      for (const auto& [edge, is_nm] : bad) {
+        auto [it, fresh] = clusters.emplace(root(edge.first), Candidate{{}, edge, false});
+        it->second.is_nm = it->second.is_nm || is_nm;
+        (void)fresh;
+      }
+      for (const auto& [v, r] : parent) clusters[root(v)].centre.push_back(v);
+      for (auto& [r, c] : clusters)
+        if (c.centre.size() >= 3) candidates.push_back(std::move(c));
+    }
+    for (const Candidate& item : candidates) {
+      const bool is_nm = item.is_nm;
+      // A folded manifold edge may sit next to a sharp edge: its patch is the part of the star within the
+      // flatness angle of the fold's plane (the no-new-boundary rule below keeps it joined to the rest).
+      const Vec3 fold_normal = normal(edge_faces[item.edge][0]).normalized();
       std::vector<size_t> patch;
       for (size_t f = 0; f < faces.size(); ++f) {
         if (gone[f]) continue;
         const Tri& t = faces[f];
-        for (int v : t)
-          if (v == a || v == b) {
-            patch.push_back(f);
-            break;
-          }
+        bool near = false;
+        for (int v : t) near = near || std::binary_search(item.centre.begin(), item.centre.end(), v);
+        if (!near) continue;
+        if (!is_nm && !(std::abs(normal(t).normalized().dot(fold_normal)) >= min_cos)) continue;
+        patch.push_back(f);
       }
       std::vector<int> pv;
       bool fresh = true;
@@ -303,10 +429,6 @@ size_t RetriangulateFlatFolds(const std::vector<Vec3>& vertices, std::vector<Tri
       std::sort(pv.begin(), pv.end());
       pv.erase(std::unique(pv.begin(), pv.end()), pv.end());
       if (pv.size() > 24) continue;
-      auto normal = [&](const Tri& t) {
-        const Vec3& p0 = vertices[static_cast<size_t>(t[0])];
-        return Vec3((vertices[static_cast<size_t>(t[1])] - p0).cross(vertices[static_cast<size_t>(t[2])] - p0));
-      };
       Vec3 ref = normal(faces[patch[0]]).normalized(), mean = Vec3::Zero();
       for (size_t f : patch) {
         const Vec3 nf = normal(faces[f]);
@@ -354,28 +476,53 @@ size_t RetriangulateFlatFolds(const std::vector<Vec3>& vertices, std::vector<Tri
                                                    vertices[static_cast<size_t>(pv[k])]);
             if (quality >= min_quality && quality > 0.0) tris.push_back({pv[i], pv[j], pv[k]});
           }
-      // Valence change on the patch's edges; accept when non-manifold edges drop and no boundary appears.
-      std::map<std::pair<int, int>, int> delta;
-      for (size_t f : patch)
-        for (int k = 0; k < 3; ++k) --delta[key(faces[f][static_cast<size_t>(k)], faces[f][static_cast<size_t>((k + 1) % 3)])];
-      bool duplicate = false;
-      for (const Tri& t : tris) {
-        for (int k = 0; k < 3; ++k) ++delta[key(t[static_cast<size_t>(k)], t[static_cast<size_t>((k + 1) % 3)])];
-        bool own = false;
-        for (size_t f : patch) own = own || Sorted(faces[f]) == t;
-        duplicate = duplicate || (!own && existing.count(t) > 0);
+      auto acceptable = [&](const std::vector<Tri>& cand) {
+        // The patch's edges before and after; accept when non-manifold plus folded edges drop, with no more
+        // non-manifold and no more boundary edges.
+        std::map<Edge, std::vector<Tri>> after;
+        for (size_t f : patch)
+          for (int k = 0; k < 3; ++k) {
+            const Edge e = key(faces[f][static_cast<size_t>(k)], faces[f][static_cast<size_t>((k + 1) % 3)]);
+            after.emplace(e, edge_faces[e]);
+          }
+        for (const Tri& t : cand)
+          for (int k = 0; k < 3; ++k) {
+            const Edge e = key(t[static_cast<size_t>(k)], t[static_cast<size_t>((k + 1) % 3)]);
+            const auto it = edge_faces.find(e);
+            after.emplace(e, it == edge_faces.end() ? std::vector<Tri>() : it->second);
+          }
+        int nm_before = 0, nm_after = 0, open_before = 0, open_after = 0, fold_before = 0, fold_after = 0;
+        for (auto& [e, fs] : after) {
+          nm_before += fs.size() >= 3;
+          open_before += fs.size() == 1;
+          fold_before += fs.size() == 2 && folded(e, fs);
+          for (size_t f : patch) {
+            const auto it = std::find(fs.begin(), fs.end(), Sorted(faces[f]));
+            if (it != fs.end()) fs.erase(it);
+          }
+          for (const Tri& t : cand)
+            if ((t[0] == e.first || t[1] == e.first || t[2] == e.first) && (t[0] == e.second || t[1] == e.second || t[2] == e.second))
+              fs.push_back(t);
+          nm_after += fs.size() >= 3;
+          open_after += fs.size() == 1;
+          fold_after += fs.size() == 2 && folded(e, fs);
+        }
+        bool duplicate = false;
+        for (const Tri& t : cand) {
+          bool own = false;
+          for (size_t f : patch) own = own || Sorted(faces[f]) == t;
+          duplicate = duplicate || (!own && existing.count(t) > 0);
+        }
+        return !(duplicate || nm_after > nm_before || open_after > open_before || nm_after + fold_after >= nm_before + fold_before);
+      };
+      bool ok = acceptable(tris);
+      if (!ok) {
+        // Fallback: the patch's outline (edges with one patch face) as one simple polygon, ear-clipped best
+        // ear first (its interior vertices are dropped).
+        tris = EarClip(vertices, patch, faces, q, min_quality);
+        ok = !tris.empty() && acceptable(tris);
       }
-      if (duplicate) continue;
-      int nm_before = 0, nm_after = 0, open_before = 0, open_after = 0;
-      for (const auto& [e, d] : delta) {
-        const auto it = valence.find(e);
-        const int before = it == valence.end() ? 0 : it->second, after = before + d;
-        nm_before += before >= 3;
-        nm_after += after >= 3;
-        open_before += before == 1;
-        open_after += after == 1;
-      }
-      if (!(nm_after < nm_before && open_after <= open_before)) continue;
+      if (!ok) continue;
       for (size_t f : patch) gone[f] = 1;
       added.insert(added.end(), tris.begin(), tris.end());
       for (int v : pv) touched[static_cast<size_t>(v)] = 1;
