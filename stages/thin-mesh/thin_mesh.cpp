@@ -405,40 +405,57 @@ size_t RetriangulateFlatFolds(const std::vector<Vec3>& vertices, std::vector<Tri
     }
     for (const Candidate& item : candidates) {
       const bool is_nm = item.is_nm;
-      // A folded manifold edge may sit next to a sharp edge: its patch is the part of the star within the
-      // flatness angle of the fold's plane (the no-new-boundary rule below keeps it joined to the rest).
-      const Vec3 fold_normal = normal(edge_faces[item.edge][0]).normalized();
+      // The plane of the fold: a face of the first same-side pair on the candidate's edge.
+      Vec3 fold_normal = Vec3::Zero();
+      {
+        const std::vector<Tri>& fs = edge_faces[item.edge];
+        for (size_t i = 0; i < fs.size() && fold_normal.isZero(); ++i)
+          for (size_t j = i + 1; j < fs.size() && fold_normal.isZero(); ++j)
+            if (folded(item.edge, {fs[i], fs[j]})) fold_normal = normal(fs[i]).normalized();
+      }
       std::vector<size_t> patch;
-      for (size_t f = 0; f < faces.size(); ++f) {
-        if (gone[f]) continue;
-        const Tri& t = faces[f];
-        bool near = false;
-        for (int v : t) near = near || std::binary_search(item.centre.begin(), item.centre.end(), v);
-        if (!near) continue;
-        if (!is_nm && !(std::abs(normal(t).normalized().dot(fold_normal)) >= min_cos)) continue;
-        patch.push_back(f);
-      }
       std::vector<int> pv;
-      bool fresh = true;
-      for (size_t f : patch)
-        for (int v : faces[f]) {
-          pv.push_back(v);
-          fresh = fresh && !touched[static_cast<size_t>(v)];
+      Vec3 mean = Vec3::Zero();
+      // The whole star of the candidate's vertices first (non-manifold candidates), then only its part within
+      // the flatness angle of the fold's plane: a fold next to a sharp edge or a branching curve (the rules
+      // below keep that part joined to the rest and the shared edges in place).
+      bool found = false, fresh = true;
+      for (int restricted = is_nm ? 0 : 1; restricted <= 1 && !found && fresh; ++restricted) {
+        if (restricted && fold_normal.isZero()) break;
+        patch.clear();
+        pv.clear();
+        for (size_t f = 0; f < faces.size(); ++f) {
+          if (gone[f]) continue;
+          const Tri& t = faces[f];
+          bool near = false;
+          for (int v : t) near = near || std::binary_search(item.centre.begin(), item.centre.end(), v);
+          if (!near) continue;
+          if (restricted && !(std::abs(normal(t).normalized().dot(fold_normal)) >= min_cos)) continue;
+          patch.push_back(f);
         }
-      if (!fresh) continue;  // one patch per neighbourhood and round: the valences below are the round's
-      std::sort(pv.begin(), pv.end());
-      pv.erase(std::unique(pv.begin(), pv.end()), pv.end());
-      if (pv.size() > 24) continue;
-      Vec3 ref = normal(faces[patch[0]]).normalized(), mean = Vec3::Zero();
-      for (size_t f : patch) {
-        const Vec3 nf = normal(faces[f]);
-        mean += nf.dot(ref) >= 0.0 ? nf : Vec3(-nf);
+        if (patch.empty()) continue;
+        for (size_t f : patch)
+          for (int v : faces[f]) {
+            pv.push_back(v);
+            fresh = fresh && !touched[static_cast<size_t>(v)];
+          }
+        std::sort(pv.begin(), pv.end());
+        pv.erase(std::unique(pv.begin(), pv.end()), pv.end());
+        if (pv.size() > 24) continue;
+        const Vec3 ref = normal(faces[patch[0]]).normalized();
+        mean = Vec3::Zero();
+        for (size_t f : patch) {
+          const Vec3 nf = normal(faces[f]);
+          mean += nf.dot(ref) >= 0.0 ? nf : Vec3(-nf);
+        }
+        if (!(mean.norm() > 0.0)) continue;
+        mean.normalize();
+        bool flat = true;
+        for (size_t f : patch) flat = flat && std::abs(normal(faces[f]).normalized().dot(mean)) >= min_cos;
+        found = flat;
       }
-      if (!(mean.norm() > 0.0)) continue;
-      mean.normalize();
-      bool flat = true;
-      for (size_t f : patch) flat = flat && std::abs(normal(faces[f]).normalized().dot(mean)) >= min_cos;
-      if (!flat) continue;
+      // One patch per neighbourhood and round: the valences below are the round's.
+      if (!found || !fresh) continue;
       const Vec3 u = (std::abs(mean.x()) < 0.9 ? Vec3::UnitX() : Vec3::UnitY()).cross(mean).normalized();
       const Vec3 w = mean.cross(u);
       std::unordered_map<int, Eigen::Vector2d> q;
@@ -492,17 +509,28 @@ size_t RetriangulateFlatFolds(const std::vector<Vec3>& vertices, std::vector<Tri
             after.emplace(e, it == edge_faces.end() ? std::vector<Tri>() : it->second);
           }
         int nm_before = 0, nm_after = 0, open_before = 0, open_after = 0, fold_before = 0, fold_after = 0;
+        bool kept_shared = true;
         for (auto& [e, fs] : after) {
           nm_before += fs.size() >= 3;
           open_before += fs.size() == 1;
           fold_before += fs.size() == 2 && folded(e, fs);
+          size_t own = 0;
           for (size_t f : patch) {
             const auto it = std::find(fs.begin(), fs.end(), Sorted(faces[f]));
-            if (it != fs.end()) fs.erase(it);
+            if (it != fs.end()) {
+              fs.erase(it);
+              ++own;
+            }
           }
+          const bool shared = own > 0 && !fs.empty();  // also used by faces outside the patch
+          bool in_new = false;
           for (const Tri& t : cand)
-            if ((t[0] == e.first || t[1] == e.first || t[2] == e.first) && (t[0] == e.second || t[1] == e.second || t[2] == e.second))
+            if ((t[0] == e.first || t[1] == e.first || t[2] == e.first) && (t[0] == e.second || t[1] == e.second || t[2] == e.second)) {
               fs.push_back(t);
+              in_new = true;
+            }
+          // An edge the patch shares with other faces stays: a branching curve is never cut off.
+          kept_shared = kept_shared && (!shared || in_new);
           nm_after += fs.size() >= 3;
           open_after += fs.size() == 1;
           fold_after += fs.size() == 2 && folded(e, fs);
@@ -513,7 +541,7 @@ size_t RetriangulateFlatFolds(const std::vector<Vec3>& vertices, std::vector<Tri
           for (size_t f : patch) own = own || Sorted(faces[f]) == t;
           duplicate = duplicate || (!own && existing.count(t) > 0);
         }
-        return !(duplicate || nm_after > nm_before || open_after > open_before || nm_after + fold_after >= nm_before + fold_before);
+        return kept_shared && !(duplicate || nm_after > nm_before || open_after > open_before || nm_after + fold_after >= nm_before + fold_before);
       };
       bool ok = acceptable(tris);
       if (!ok) {
