@@ -57,16 +57,19 @@ struct ThinMeshStats {
 ///     largest mean centroid UDF first (Fig. 8's rule), repeated until none can go. So isolated small pieces, fins and the sides of residual
 ///     polyhedra ("non-manifold polyhedral artifacts", Sec. 3.4) go, while a surface is never cut open.
 ///  3. Steps 1–2 repeat until neither changes the mesh.
-///  4. Flat folds: for each non-manifold edge (a, b) whose surrounding faces (those touching a or b) are all
-///     within fold_flatness_deg of their best-fit plane, those faces are replaced by the 2-D Delaunay
-///     triangles of their vertices (projected on that plane) that lie inside the projected patch, when that
-///     lowers the number of non-manifold edges and adds no boundary edge. Branching edges (sheets meeting at
-///     an angle) are not flat and stay. Unreferenced vertices are dropped (order kept).
+///  4. Flat folds (two faces on the same side of an edge, overlapping): for each non-manifold or folded edge,
+///     then each cluster of vertices joined by such edges, the faces touching it (or only those within
+///     fold_flatness_deg of the fold's plane when that star is not flat) are replaced by the 2-D Delaunay
+///     triangles of their vertices projected on their best-fit plane (inside the projected patch), or else
+///     by ear clipping of the patch's outline, when all patch faces are within fold_flatness_deg of that
+///     plane, the edges shared with faces outside the patch stay, and the result has fewer non-manifold +
+///     folded edges, no more non-manifold and no more boundary edges. Branching edges (sheets meeting at an
+///     angle) are not flat and stay. Unreferenced vertices are dropped (order kept).
 ///
 /// \param udf    the field, for the centroid values
 /// \param thick  vertices + faces with valid indices (the caller validates them)
 /// \param stats  optional counts
-/// Deterministic (faces keep their input order), independent of the thread count.
+/// Deterministic (faces keep their input order, step 4's new faces last), independent of the thread count.
 TriangleMesh ThinMesh(const Udf& udf, const TriangleMesh& thick, const ThinMeshOptions& options, Monitor& monitor,
                       ThinMeshStats* stats = nullptr);
 
