@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # End-to-end tests of the chained executables through the three drivers: pipelines/voroudf.sh,
-# Makefile.example and pipelines/Snakefile. Usage: test_pipelines.sh BIN_DIR {voroudf-sh|make|snakemake}
+# Makefile.example and pipelines/Snakefile. Usage: test_pipelines.sh BIN_DIR {voroudf-sh|make|snakemake|benchmark}
 set -euo pipefail
 BIN=$(cd "$1" && pwd)
 WHAT=$2
@@ -54,6 +54,18 @@ case "$WHAT" in
       --config shapes=sphere,torus out=snake count=400 bin="$BIN" > "$TMP/log" 2>&1) ||
       { cat "$TMP/log"; fail "snakemake failed"; }
     for s in sphere torus; do [ -s "$TMP/snake/$s/mesh.ply" ] || fail "snakemake did not build $s"; done
+    ;;
+  benchmark)
+    # A folder with one good mesh and one broken file: two rows, the broken one with its error, and a table.
+    bash "$ROOT/pipelines/voroudf.sh" --udf shape:sphere -o "$TMP/s" --count 300 2> /dev/null
+    mkdir -p "$TMP/data/cad"
+    cp "$TMP/s/mesh.ply" "$TMP/data/cad/ball.ply"
+    printf 'OFF\n3 1 0\n0 0 0\n1 0\n' > "$TMP/data/cad/broken.off"
+    "$ROOT/pipelines/benchmark" --sets cad --data "$TMP/data" --out "$TMP/bench" --bin "$BIN" -j 2 --count 300 \
+      > "$TMP/log" 2>&1 || { cat "$TMP/log"; fail "the benchmark driver failed"; }
+    grep -q '^| cad | 2 | 1 |' "$TMP/bench/results.md" || { cat "$TMP/bench/results.md"; fail "no table row"; }
+    grep -q '^cad,ball,' "$TMP/bench/results.csv" || fail "no CSV row for the good mesh"
+    grep -q '^cad,broken,.*exit 3' "$TMP/bench/results.csv" || { cat "$TMP/bench/results.csv"; fail "no error row"; }
     ;;
   *) fail "unknown test '$WHAT'" ;;
 esac
