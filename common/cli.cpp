@@ -109,6 +109,12 @@ std::string StageCli::EffectiveOptions(bool semantic_only) const {
   return out.str();
 }
 
+std::unique_ptr<Udf> StageCli::OpenUdf(Monitor& monitor) const {
+  std::unique_ptr<Udf> udf = voroudf::OpenUdf(*udf_spec_, udf_options_);
+  monitor.Info("UDF: " + udf->Describe());
+  return udf;
+}
+
 Provenance StageCli::provenance() const {
   return Provenance{program_, EffectiveOptions(true), udf_spec_ ? *udf_spec_ : std::string()};
 }

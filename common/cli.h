@@ -41,6 +41,10 @@ class StageCli {
 
   const UdfSourceOptions& udf_options() const { return udf_options_; }
 
+  /// Opens the --udf source with the source options and logs what it is (every stage's first step).
+  /// \pre AddUdf was called and the command line parsed
+  std::unique_ptr<Udf> OpenUdf(Monitor& monitor) const;
+
   /// Provenance for output headers: the program, its result-changing options and the UDF SPEC.
   Provenance provenance() const;
 

@@ -32,8 +32,7 @@ int main(int argc, char** argv) {
   app.add_option("--proj-max-iters", options.proj_max_iters, "projection steps before a sample is dropped");
 
   return cli.Run(argc, argv, [&] { options.Check(); }, [&](voroudf::Monitor& monitor) {
-    const auto udf = voroudf::OpenUdf(udf_spec, cli.udf_options());
-    monitor.Info("UDF: " + udf->Describe());
+    const auto udf = cli.OpenUdf(monitor);
     const voroudf::SeedCloud seeds = voroudf::ReadSeeds(input);
     if (seeds.size() == 0) throw voroudf::InputError(input, "the seeds file has no seeds");
     const voroudf::GvdResult gvd = voroudf::BuildGvd(*udf, seeds, options, graph && !labels.empty(), monitor);

@@ -42,8 +42,7 @@ int main(int argc, char** argv) {
   app.add_option("--proj-max-iters", o.proj_max_iters, "projection steps before a move is undone");
 
   return cli.Run(argc, argv, [&] { o.Check(); }, [&](voroudf::Monitor& monitor) {
-    const auto udf = voroudf::OpenUdf(udf_spec, cli.udf_options());
-    monitor.Info("UDF: " + udf->Describe());
+    const auto udf = cli.OpenUdf(monitor);
     const voroudf::SeedCloud seeds0 = voroudf::ReadSeeds(input);
     std::error_code ec;
     if (!trace_dir.empty() && !std::filesystem::create_directories(trace_dir, ec) && ec)

@@ -24,8 +24,7 @@ int main(int argc, char** argv) {
   app.add_option("--proj-max-iters", options.proj_max_iters, "projection steps before a seed is dropped");
 
   return cli.Run(argc, argv, [&] { options.Check(); }, [&](voroudf::Monitor& monitor) {
-    const auto udf = voroudf::OpenUdf(udf_spec, cli.udf_options());
-    monitor.Info("UDF: " + udf->Describe());
+    const auto udf = cli.OpenUdf(monitor);
     const voroudf::SeedCloud seeds = voroudf::SampleSeeds(*udf, options, monitor);
     voroudf::WriteSeeds(output, seeds, cli.provenance(), ascii);
     monitor.Info("wrote " + std::to_string(seeds.size()) + " seeds to " + output);

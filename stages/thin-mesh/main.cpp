@@ -25,8 +25,7 @@ int main(int argc, char** argv) {
                  "re-triangulate faces around a non-manifold edge within this angle (deg) of a plane (0: off)");
 
   return cli.Run(argc, argv, [&] { options.Check(); }, [&](voroudf::Monitor& monitor) {
-    const auto udf = voroudf::OpenUdf(udf_spec, cli.udf_options());
-    monitor.Info("UDF: " + udf->Describe());
+    const auto udf = cli.OpenUdf(monitor);
     const voroudf::TriangleMesh thick = voroudf::ReadMeshPly(input);
     const voroudf::TriangleMesh mesh = voroudf::ThinMesh(*udf, thick, options, monitor);
     voroudf::WriteMeshPly(output, mesh, cli.provenance(), ascii);
