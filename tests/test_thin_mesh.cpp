@@ -196,6 +196,32 @@ TEST(ThinMesh, DuplicateAndDegenerateFacesNeverSurvive) {
   for (const Tri& t : out.faces) EXPECT_GT(TriangleQuality(out.vertices[t[0]], out.vertices[t[1]], out.vertices[t[2]]), 0.0);
 }
 
+TEST(ThinMesh, AFaceSpanningAVertexOnItsEdgeIsSplitThere) {
+  const auto udf = MakeShape("disc");
+  // Five seeds on a line (0..4) between two rows; the upper row's dual face (1, 3, s1) spans seed 2, which lies
+  // on its edge, as where seeds along a curve are denser than the samples resolve. The degenerate face
+  // (1, 2, 3) says that 2 lies on edge 1-3; the face is split into (1, 2, s1) and (2, 3, s1), closing the strip.
+  TriangleMesh m;
+  for (int i = 0; i < 5; ++i) m.vertices.push_back({-0.2 + 0.1 * i, 0.0, 0.0});
+  for (double y : {0.1, -0.1})
+    for (double x : {-0.15, 0.0, 0.15}) m.vertices.push_back({x, y, 0.0});
+  const int s0 = 5, s1 = 6, s2 = 7, t0 = 8, t1 = 9, t2 = 10;
+  m.faces = {{0, 1, s0}, {1, s1, s0}, {1, 3, s1}, {3, s2, s1}, {3, 4, s2},                     // upper, spans 2
+             {0, 1, t0}, {1, t1, t0}, {1, 2, t1}, {2, 3, t1}, {3, t2, t1}, {3, 4, t2},         // lower
+             {1, 2, 3}};                                                                      // degenerate
+  ThinMeshStats stats;
+  const TriangleMesh out = ThinMesh(*udf, m, ThinMeshOptions{}, Monitor::Null(), &stats);
+  EXPECT_EQ(stats.faces_split, 1u);
+  const std::set<Tri> faces = SortedFaces(out);
+  EXPECT_EQ(faces.size(), 12u);
+  EXPECT_TRUE(faces.count({1, 2, s1}) && faces.count({2, 3, s1}));
+  EXPECT_FALSE(faces.count({1, 3, s1}));
+  // The line's edges now have a face on each side: the strip's only boundary is its outline.
+  const TopologyStats topo = ComputeTopology(out);
+  EXPECT_EQ(topo.boundary_edges, 8u);  // 0, s0, s1, s2, 4, t2, t1, t0
+  EXPECT_EQ(topo.euler, 1);
+}
+
 TEST(ThinMesh, ManifoldComponentsAreOrientedConsistently) {
   const auto udf = MakeShape("disc");
   TriangleMesh m;

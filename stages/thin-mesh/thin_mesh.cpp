@@ -583,29 +583,78 @@ TriangleMesh ThinMesh(const Udf& udf, const TriangleMesh& thick, const ThinMeshO
   options.Check();
   ThinMeshStats st;
 
-  // 0. Degenerate and duplicate faces.
+  // 0. Degenerate faces, faces spanning a vertex on their edge, duplicate faces.
   std::vector<Tri> faces;
   faces.reserve(thick.faces.size());
-  std::unordered_set<Tri, TriHash> seen;
+  const auto quality_of = [&](const Tri& t) {
+    return TriangleQuality(thick.vertices[static_cast<size_t>(t[0])], thick.vertices[static_cast<size_t>(t[1])],
+                           thick.vertices[static_cast<size_t>(t[2])]);
+  };
+  // A degenerate face over three distinct vertices is three seeds on one line (a sharp edge or a branching
+  // curve): its middle vertex lies on the edge between the other two. Keyed by that edge.
+  std::map<std::pair<int, int>, int> middle;
   for (const Tri& t : thick.faces) {
     if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2]) {
       ++st.degenerate_faces;
       continue;
     }
-    const double quality = TriangleQuality(thick.vertices[static_cast<size_t>(t[0])],
-                                           thick.vertices[static_cast<size_t>(t[1])],
-                                           thick.vertices[static_cast<size_t>(t[2])]);
+    const double quality = quality_of(t);
     if (!(quality >= options.degenerate_quality) || quality == 0.0) {
       ++st.degenerate_faces;
-      continue;
-    }
-    if (!seen.insert(Sorted(t)).second) {
-      ++st.duplicate_faces;
+      int far = 0;  // the vertex opposite the longest edge is the middle one
+      double longest = -1.0;
+      for (int k = 0; k < 3; ++k) {
+        const double len = (thick.vertices[static_cast<size_t>(t[static_cast<size_t>((k + 1) % 3)])] -
+                            thick.vertices[static_cast<size_t>(t[static_cast<size_t>((k + 2) % 3)])]).squaredNorm();
+        if (len > longest) longest = len, far = k;
+      }
+      const int a = t[static_cast<size_t>((far + 1) % 3)], b = t[static_cast<size_t>((far + 2) % 3)];
+      middle.emplace(std::make_pair(std::min(a, b), std::max(a, b)), t[static_cast<size_t>(far)]);
       continue;
     }
     faces.push_back(t);
   }
-  monitor.Info(Count(thick.faces.size(), "faces in; dropped ") + Count(st.degenerate_faces, "degenerate and ") +
+  // A face (a, b, s) over an edge whose middle vertex m is known spans over m: where the seeds along a curve
+  // are denser than the dense samples resolve, the dual gets (a, b, s) instead of (a, m, s) and (m, b, s),
+  // and thinning cannot recover the curve's edges. Such a face is split into those two (repeatedly: the
+  // halves may span further vertices); the halves that exist already are dropped as duplicates below.
+  if (!middle.empty()) {
+    std::vector<Tri> split;
+    std::vector<Tri> stack(faces.rbegin(), faces.rend());
+    while (!stack.empty()) {
+      const Tri t = stack.back();
+      stack.pop_back();
+      bool done = false;
+      for (int k = 0; k < 3 && !done; ++k) {
+        const int a = t[static_cast<size_t>(k)], b = t[static_cast<size_t>((k + 1) % 3)], c = t[static_cast<size_t>((k + 2) % 3)];
+        const auto it = middle.find({std::min(a, b), std::max(a, b)});
+        if (it == middle.end() || it->second == c) continue;
+        const Tri h1{a, it->second, c}, h2{it->second, b, c};
+        if (!(quality_of(h1) >= options.degenerate_quality) || !(quality_of(h2) >= options.degenerate_quality)) continue;
+        ++st.faces_split;
+        stack.push_back(h2);
+        stack.push_back(h1);
+        done = true;
+      }
+      if (!done) split.push_back(t);
+    }
+    faces.swap(split);
+  }
+  {
+    std::unordered_set<Tri, TriHash> seen;
+    std::vector<Tri> unique;
+    unique.reserve(faces.size());
+    for (const Tri& t : faces) {
+      if (seen.insert(Sorted(t)).second) {
+        unique.push_back(t);
+      } else {
+        ++st.duplicate_faces;
+      }
+    }
+    faces.swap(unique);
+  }
+  monitor.Info(Count(thick.faces.size(), "faces in; dropped ") + Count(st.degenerate_faces, "degenerate faces; split ") +
+               Count(st.faces_split, "faces over a vertex on their edge; dropped ") +
                Count(st.duplicate_faces, "duplicate faces"));
 
   std::vector<Vec3> centroid(faces.size());

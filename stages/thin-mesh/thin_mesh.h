@@ -32,6 +32,7 @@ struct ThinMeshOptions {
 struct ThinMeshStats {
   size_t duplicate_faces = 0;       ///< faces over the same vertex set as an earlier face, dropped
   size_t degenerate_faces = 0;      ///< dropped
+  size_t faces_split = 0;           ///< faces over a vertex lying on their edge, split in two there
   size_t tetrahedra = 0;            ///< closed tetrahedra found (over all rounds)
   size_t tetrahedra_thinned = 0;    ///< of those, the ones a face pair was removed from
   size_t tetrahedra_left = 0;       ///< closed tetrahedra at the end (no pair on a manifold edge)
@@ -45,7 +46,9 @@ struct ThinMeshStats {
 /// Thins a thick dual mesh (paper Sec. 3.4). Written by hand: no installed library handles triangle sets
 /// with edges of any valence (OpenMesh refuses them, DESIGN.md).
 ///
-///  0. Drops degenerate faces and duplicate faces (same vertex set; the first is kept).
+///  0. Drops degenerate faces; a face (a, b, s) whose edge ab has a vertex m on it (known from a degenerate
+///     face (a, m, b)) is split into (a, m, s) and (m, b, s); then drops duplicate faces (same vertex set; the
+///     first is kept).
 ///  1. Closed tetrahedra: 4 vertices whose 4 triangles are all present, processed in increasing order of
 ///     their sorted vertex quadruple. From each (whose faces are all still present) the pair of faces that
 ///     share an edge of valence exactly 2 (a manifold edge, so removing the pair opens no hole elsewhere)
