@@ -222,6 +222,29 @@ TEST(ThinMesh, AFaceSpanningAVertexOnItsEdgeIsSplitThere) {
   EXPECT_EQ(topo.euler, 1);
 }
 
+TEST(ThinMesh, ATriangularHoleIsClosedButNotTheOutline) {
+  const auto udf = MakeShape("disc");
+  TriangleMesh m;
+  AddGrid(m, 6, 6);  // 72 faces; the outline has 24 edges
+  const Tri lost = m.faces[30];  // an interior face: its three edges become a cycle of boundary edges
+  m.faces.erase(m.faces.begin() + 30);
+  ThinMeshStats stats;
+  const TriangleMesh out = ThinMesh(*udf, m, ThinMeshOptions{}, Monitor::Null(), &stats);
+  EXPECT_EQ(stats.holes_closed, 1u);
+  Tri sorted = lost;
+  std::sort(sorted.begin(), sorted.end());
+  EXPECT_TRUE(SortedFaces(out).count(sorted));
+  const TopologyStats topo = ComputeTopology(out);
+  EXPECT_EQ(topo.boundary_edges, 24u);
+  EXPECT_EQ(topo.euler, 1);
+
+  // A lone triangle is a boundary loop of three edges that already has its face: nothing is added.
+  TriangleMesh tri;
+  tri.vertices = {{0.0, 0.0, 0.0}, {0.1, 0.0, 0.0}, {0.0, 0.1, 0.0}};
+  tri.faces = {{0, 1, 2}};
+  EXPECT_EQ(ThinMesh(*udf, tri, MinFaces(1), Monitor::Null()).faces.size(), 1u);
+}
+
 TEST(ThinMesh, ManifoldComponentsAreOrientedConsistently) {
   const auto udf = MakeShape("disc");
   TriangleMesh m;

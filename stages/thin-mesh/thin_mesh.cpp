@@ -393,6 +393,13 @@ size_t RetriangulateFlatFolds(const std::vector<Vec3>& vertices, std::vector<Tri
         const int ra = root(edge.first), rb = root(edge.second);
         parent[std::max(ra, rb)] = std::min(ra, rb);
       }
+      // A hole next to folds (a boundary edge between two of their vertices) is part of the same defect:
+      // the faces missing there are those the folds doubled.
+      for (const auto& [e, fs] : edge_faces) {
+        if (fs.size() != 1 || !parent.count(e.first) || !parent.count(e.second)) continue;
+        const int ra = root(e.first), rb = root(e.second);
+        parent[std::max(ra, rb)] = std::min(ra, rb);
+      }
       std::map<int, Candidate> clusters;
       for (const auto& [edge, is_nm] : bad) {
         auto [it, fresh] = clusters.emplace(root(edge.first), Candidate{{}, edge, false});
@@ -567,6 +574,38 @@ size_t RetriangulateFlatFolds(const std::vector<Vec3>& vertices, std::vector<Tri
   return replaced;
 }
 
+/// Step 5: adds the face of every cycle of three boundary edges (edges with one face) whose triangle is not a
+/// face yet and is not degenerate. Returns the number added.
+size_t CloseTriangularHoles(const std::vector<Vec3>& vertices, std::vector<Tri>& faces, double min_quality) {
+  const EdgeFaces ef = BuildEdgeFaces(faces);
+  std::map<int, std::vector<int>> open;  // vertex -> its neighbours along boundary edges
+  for (size_t e = 0; e < ef.edges.size(); ++e)
+    if (ef.faces[e].size() == 1) {
+      open[ef.edges[e][0]].push_back(ef.edges[e][1]);
+      open[ef.edges[e][1]].push_back(ef.edges[e][0]);
+    }
+  std::set<Tri> existing;
+  for (const Tri& t : faces) existing.insert(Sorted(t));
+  size_t added = 0;
+  for (auto& [a, na] : open) std::sort(na.begin(), na.end());
+  for (const auto& [a, na] : open)
+    for (int b : na) {
+      if (b <= a) continue;
+      for (int c : open[b]) {
+        if (c <= b || !std::binary_search(na.begin(), na.end(), c)) continue;
+        const Tri t{a, b, c};
+        if (existing.count(t)) continue;
+        const double q = TriangleQuality(vertices[static_cast<size_t>(a)], vertices[static_cast<size_t>(b)],
+                                         vertices[static_cast<size_t>(c)]);
+        if (!(q >= min_quality) || q == 0.0) continue;
+        faces.push_back(t);
+        existing.insert(t);
+        ++added;
+      }
+    }
+  return added;
+}
+
 std::string Count(size_t n, const char* what) { return std::to_string(n) + " " + what; }
 
 }  // namespace
@@ -720,6 +759,10 @@ TriangleMesh ThinMesh(const Udf& udf, const TriangleMesh& thick, const ThinMeshO
                                                       options.degenerate_quality);
     monitor.Info(Count(st.folds_retriangulated, "flat folds re-triangulated"));
   }
+  // 5. Triangular holes: three boundary edges that form a cycle are a junction whose face the thinning (or
+  // the dual) lost; a true boundary loop of three edges does not occur in a mesh of this resolution.
+  st.holes_closed = CloseTriangularHoles(thick.vertices, kept, options.degenerate_quality);
+  if (st.holes_closed > 0) monitor.Info(Count(st.holes_closed, "triangular holes closed"));
   Thinner oriented(std::move(kept), std::vector<double>());
   oriented.OrientComponents();
 

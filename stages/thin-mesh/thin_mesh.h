@@ -40,6 +40,7 @@ struct ThinMeshStats {
   size_t component_faces_removed = 0;
   size_t small_components_left = 0; ///< small components whose removal would have opened a hole
   size_t folds_retriangulated = 0;   ///< step 4: patches around flat non-manifold edges replaced
+  size_t holes_closed = 0;           ///< step 5: cycles of three boundary edges given their face
   int rounds = 0;                   ///< rounds of (tetrahedra, components) until nothing changed
 };
 
@@ -67,7 +68,9 @@ struct ThinMeshStats {
 ///     by ear clipping of the patch's outline, when all patch faces are within fold_flatness_deg of that
 ///     plane, the edges shared with faces outside the patch stay, and the result has fewer non-manifold +
 ///     folded edges, no more non-manifold and no more boundary edges. Branching edges (sheets meeting at an
-///     angle) are not flat and stay. Unreferenced vertices are dropped (order kept).
+///     angle) are not flat and stay.
+///  5. Every cycle of three boundary edges without its face gets that face (a junction lost by the dual or by
+///     steps 1–4). Unreferenced vertices are dropped (order kept).
 ///
 /// \param udf    the field, for the centroid values
 /// \param thick  vertices + faces with valid indices (the caller validates them)
