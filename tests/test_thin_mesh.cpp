@@ -245,6 +245,25 @@ TEST(ThinMesh, ATriangularHoleIsClosedButNotTheOutline) {
   EXPECT_EQ(ThinMesh(*udf, tri, MinFaces(1), Monitor::Null()).faces.size(), 1u);
 }
 
+TEST(ThinMesh, AFoldAtAnOpenRimBecomesBoundary) {
+  const auto udf = MakeShape("disc");
+  TriangleMesh m;
+  AddGrid(m, 6, 6);  // vertex (i, j) is j * 7 + i; row j = 0 is the rim y = -0.3
+  // Cell (2, 0) is covered twice: by its two faces and by a fan around an inner point p. Its inner edges are
+  // then non-manifold and the rim edge 2-3 has two faces on the same (inner) side. Whichever cover goes,
+  // 2-3 is left with one face: a boundary edge, which at the rim is right, so only the rim pass may do it.
+  const int p = AddVertex(m, {-0.05, -0.26, 0.0});
+  const int v20 = 2, v30 = 3, v31 = 10, v21 = 9;
+  for (const Tri& t : std::vector<Tri>{{v20, v30, p}, {v30, v31, p}, {v31, v21, p}, {v21, v20, p}}) m.faces.push_back(t);
+  ThinMeshStats stats;
+  const TriangleMesh out = ThinMesh(*udf, m, ThinMeshOptions{}, Monitor::Null(), &stats);
+  EXPECT_EQ(stats.rim_folds_opened, 1u);
+  const TopologyStats topo = ComputeTopology(out);
+  EXPECT_EQ(topo.nonmanifold_edges, 0u);
+  EXPECT_EQ(topo.boundary_edges, 24u);
+  EXPECT_EQ(topo.euler, 1);
+}
+
 TEST(ThinMesh, ManifoldComponentsAreOrientedConsistently) {
   const auto udf = MakeShape("disc");
   TriangleMesh m;

@@ -259,6 +259,23 @@ class Thinner {
   std::unordered_map<Tri, int, TriHash> by_vertices_;
 };
 
+/// Twice the signed area of the 2-D triangle (o, x, y): positive when counter-clockwise.
+double Cross2(const Eigen::Vector2d& o, const Eigen::Vector2d& x, const Eigen::Vector2d& y) {
+  return (x - o).x() * (y - o).y() - (x - o).y() * (y - o).x();
+}
+
+/// Whether the 2-D point c lies in one of the faces `patch` of `faces`, projected to the coordinates `q`.
+bool InsidePatch(const std::vector<Tri>& faces, const std::vector<size_t>& patch,
+                 const std::unordered_map<int, Eigen::Vector2d>& q, const Eigen::Vector2d& c) {
+  for (size_t f : patch) {
+    const Tri& t = faces[f];
+    const double d0 = Cross2(q.at(t[0]), q.at(t[1]), c), d1 = Cross2(q.at(t[1]), q.at(t[2]), c),
+                 d2 = Cross2(q.at(t[2]), q.at(t[0]), c);
+    if ((d0 >= 0 && d1 >= 0 && d2 >= 0) || (d0 <= 0 && d1 <= 0 && d2 <= 0)) return true;
+  }
+  return false;
+}
+
 /// Ear clipping of the outline of `patch` (its edges used by one patch face, which must form one simple
 /// cycle) in the 2-D coordinates `q`: best ear (triangle quality) first. Empty when that fails.
 std::vector<Tri> EarClip(const std::vector<Vec3>& vertices, const std::vector<size_t>& patch, const std::vector<Tri>& faces,
@@ -290,9 +307,7 @@ std::vector<Tri> EarClip(const std::vector<Vec3>& vertices, const std::vector<si
   }
   if (poly.size() != next.size()) return {};
   auto at = [&](int v) { return q.at(v); };
-  auto cross2 = [](const Eigen::Vector2d& o, const Eigen::Vector2d& x, const Eigen::Vector2d& y) {
-    return (x - o).x() * (y - o).y() - (x - o).y() * (y - o).x();
-  };
+  const auto cross2 = Cross2;
   double area = 0.0;
   for (size_t i = 0; i < poly.size(); ++i) area += cross2(Eigen::Vector2d::Zero(), at(poly[i]), at(poly[(i + 1) % poly.size()]));
   if (area < 0.0) std::reverse(poly.begin(), poly.end());
@@ -328,13 +343,98 @@ std::vector<Tri> EarClip(const std::vector<Vec3>& vertices, const std::vector<si
   return out;
 }
 
+/// A triangulation of the projected patch (2-D coordinates `q` of the patch vertices `pv`) that keeps the
+/// patch's edges shared with faces outside it: those edges first, then every other vertex pair by increasing
+/// length whose segment stays inside the projected patch and crosses no edge taken; the triangles are the
+/// empty 3-cycles of the edges taken whose centroids lie inside the patch. A greedy triangulation, by hand:
+/// at most 24 points, and CGAL's constrained Delaunay would want a simple polygon, which a fold's outline is
+/// not. Empty if the shared edges cross or a triangle is degenerate.
+std::vector<Tri> GreedyTriangulation(const std::vector<Vec3>& vertices, const std::vector<Tri>& faces,
+                                     const std::vector<size_t>& patch, const std::vector<int>& pv,
+                                     std::unordered_map<int, Eigen::Vector2d>& q,
+                                     const std::map<std::pair<int, int>, std::vector<Tri>>& edge_faces,
+                                     double min_quality) {
+  const auto cross2 = Cross2;
+  auto inside = [&](const Eigen::Vector2d& c) { return InsidePatch(faces, patch, q, c); };
+  auto key = [](int u, int v) { return std::make_pair(std::min(u, v), std::max(u, v)); };
+  std::set<Tri> own;
+  for (size_t f : patch) own.insert(Sorted(faces[f]));
+  std::set<std::pair<int, int>> shared;
+  for (size_t f : patch)
+    for (int k = 0; k < 3; ++k) {
+      const auto e = key(faces[f][static_cast<size_t>(k)], faces[f][static_cast<size_t>((k + 1) % 3)]);
+      for (const Tri& t : edge_faces.at(e))
+        if (!own.count(t)) shared.insert(e);
+    }
+  std::vector<std::pair<int, int>> taken;
+  auto blocked = [&](int a, int b) {
+    const Eigen::Vector2d &A = q[a], &B = q[b];
+    for (const auto& [c, d] : taken) {
+      if (c == a || c == b || d == a || d == b) continue;
+      const double d1 = cross2(A, B, q[c]), d2 = cross2(A, B, q[d]), d3 = cross2(q[c], q[d], A), d4 = cross2(q[c], q[d], B);
+      if (((d1 > 0 && d2 < 0) || (d1 < 0 && d2 > 0)) && ((d3 > 0 && d4 < 0) || (d3 < 0 && d4 > 0))) return true;
+    }
+    const double len2 = (B - A).squaredNorm();
+    for (int v : pv) {  // through another vertex
+      if (v == a || v == b) continue;
+      const double t = (q[v] - A).dot(B - A) / len2;
+      if (t > 0 && t < 1 && std::abs(cross2(A, B, q[v])) < 1e-9 * len2) return true;
+    }
+    return false;
+  };
+  for (const auto& e : shared) {
+    if (blocked(e.first, e.second)) return {};
+    taken.push_back(e);
+  }
+  std::vector<std::pair<double, std::pair<int, int>>> candidates;
+  for (size_t i = 0; i < pv.size(); ++i)
+    for (size_t j = i + 1; j < pv.size(); ++j) {
+      const auto e = key(pv[i], pv[j]);
+      if (shared.count(e)) continue;
+      const Eigen::Vector2d &A = q[e.first], &B = q[e.second];
+      if (inside(0.25 * A + 0.75 * B) && inside(0.5 * (A + B)) && inside(0.75 * A + 0.25 * B))
+        candidates.push_back({(A - B).squaredNorm(), e});
+    }
+  std::sort(candidates.begin(), candidates.end());
+  for (const auto& [len2, e] : candidates)
+    if (!blocked(e.first, e.second)) taken.push_back(e);
+  std::map<int, std::set<int>> adj;
+  for (const auto& [a, b] : taken) {
+    adj[a].insert(b);
+    adj[b].insert(a);
+  }
+  std::vector<Tri> out;
+  for (const auto& [a, na] : adj)
+    for (int b : na) {
+      if (b <= a) continue;
+      for (int c : adj[b]) {
+        if (c <= b || !na.count(c)) continue;
+        const Eigen::Vector2d &A = q[a], &B = q[b], &C = q[c];
+        bool empty = true;
+        for (int v : pv) {
+          if (v == a || v == b || v == c) continue;
+          const double d0 = cross2(A, B, q[v]), d1 = cross2(B, C, q[v]), d2 = cross2(C, A, q[v]);
+          empty = empty && !((d0 > 0 && d1 > 0 && d2 > 0) || (d0 < 0 && d1 < 0 && d2 < 0));
+        }
+        if (!empty || !inside((A + B + C) / 3.0)) continue;
+        const double quality = TriangleQuality(vertices[static_cast<size_t>(a)], vertices[static_cast<size_t>(b)],
+                                               vertices[static_cast<size_t>(c)]);
+        if (!(quality >= min_quality) || quality == 0.0) return {};
+        out.push_back({a, b, c});
+      }
+    }
+  return out;
+}
+
 /// Step 4: re-triangulates flat folds. For each non-manifold edge (a, b), in edge order, the patch of faces
 /// touching a or b is replaced by the 2-D Delaunay triangulation of its vertices projected on the patch's
 /// best-fit plane, keeping the triangles inside the projected patch, when every patch face is within
 /// acos(min_cos) of that plane (a fold on a sheet, not a branching of the surface) and the replacement
-/// lowers the number of non-manifold edges without adding boundary edges. Returns the patches replaced.
+/// lowers the number of non-manifold edges without adding boundary edges. With `open_rim_folds`, a folded
+/// edge between two vertices on the mesh boundary may become a boundary edge (a fold at an open rim, whose
+/// other side is empty). Returns the patches replaced.
 size_t RetriangulateFlatFolds(const std::vector<Vec3>& vertices, std::vector<Tri>& faces, double min_cos,
-                              double min_quality) {
+                              double min_quality, bool open_rim_folds) {
   using Edge = std::pair<int, int>;
   auto key = [](int u, int v) { return std::make_pair(std::min(u, v), std::max(u, v)); };
   auto normal = [&](const Tri& t) {
@@ -362,6 +462,9 @@ size_t RetriangulateFlatFolds(const std::vector<Vec3>& vertices, std::vector<Tri
     std::map<Edge, std::vector<Tri>> edge_faces;
     for (const Tri& t : faces)
       for (int k = 0; k < 3; ++k) edge_faces[key(t[static_cast<size_t>(k)], t[static_cast<size_t>((k + 1) % 3)])].push_back(Sorted(t));
+    std::vector<char> on_rim(vertices.size(), 0);  // vertices with a boundary edge
+    for (const auto& [e, fs] : edge_faces)
+      if (fs.size() == 1) on_rim[static_cast<size_t>(e.first)] = on_rim[static_cast<size_t>(e.second)] = 1;
     std::vector<std::pair<Edge, bool>> bad;  // non-manifold edges (true) and folded manifold edges (false)
     for (const auto& [e, fs] : edge_faces)
       if (fs.size() >= 3 || (fs.size() == 2 && folded(e, fs))) bad.push_back({e, fs.size() >= 3});
@@ -467,17 +570,8 @@ size_t RetriangulateFlatFolds(const std::vector<Vec3>& vertices, std::vector<Tri
       const Vec3 w = mean.cross(u);
       std::unordered_map<int, Eigen::Vector2d> q;
       for (int v : pv) q[v] = Eigen::Vector2d(vertices[static_cast<size_t>(v)].dot(u), vertices[static_cast<size_t>(v)].dot(w));
-      auto cross2 = [](const Eigen::Vector2d& o, const Eigen::Vector2d& x, const Eigen::Vector2d& y) {
-        return (x - o).x() * (y - o).y() - (x - o).y() * (y - o).x();
-      };
-      auto inside_patch = [&](const Eigen::Vector2d& c) {
-        for (size_t f : patch) {
-          const Tri& t = faces[f];
-          const double d0 = cross2(q[t[0]], q[t[1]], c), d1 = cross2(q[t[1]], q[t[2]], c), d2 = cross2(q[t[2]], q[t[0]], c);
-          if ((d0 >= 0 && d1 >= 0 && d2 >= 0) || (d0 <= 0 && d1 <= 0 && d2 <= 0)) return true;
-        }
-        return false;
-      };
+      const auto cross2 = Cross2;
+      auto inside_patch = [&](const Eigen::Vector2d& c) { return InsidePatch(faces, patch, q, c); };
       std::vector<Tri> tris;
       for (size_t i = 0; i < pv.size(); ++i)
         for (size_t j = i + 1; j < pv.size(); ++j)
@@ -515,12 +609,13 @@ size_t RetriangulateFlatFolds(const std::vector<Vec3>& vertices, std::vector<Tri
             const auto it = edge_faces.find(e);
             after.emplace(e, it == edge_faces.end() ? std::vector<Tri>() : it->second);
           }
-        int nm_before = 0, nm_after = 0, open_before = 0, open_after = 0, fold_before = 0, fold_after = 0;
+        int nm_before = 0, nm_after = 0, open_before = 0, open_after = 0, fold_before = 0, fold_after = 0, rim_opened = 0;
         bool kept_shared = true;
         for (auto& [e, fs] : after) {
+          const bool was_open = fs.size() == 1, was_folded = fs.size() == 2 && folded(e, fs);
           nm_before += fs.size() >= 3;
-          open_before += fs.size() == 1;
-          fold_before += fs.size() == 2 && folded(e, fs);
+          open_before += was_open;
+          fold_before += was_folded;
           size_t own = 0;
           for (size_t f : patch) {
             const auto it = std::find(fs.begin(), fs.end(), Sorted(faces[f]));
@@ -541,6 +636,10 @@ size_t RetriangulateFlatFolds(const std::vector<Vec3>& vertices, std::vector<Tri
           nm_after += fs.size() >= 3;
           open_after += fs.size() == 1;
           fold_after += fs.size() == 2 && folded(e, fs);
+          // A new boundary edge is a hole, unless allowed at an open rim: both faces were on one side of the
+          // edge and both its vertices are on the boundary (the fold's other side is empty).
+          rim_opened += open_rim_folds && fs.size() == 1 && was_folded && on_rim[static_cast<size_t>(e.first)] &&
+                        on_rim[static_cast<size_t>(e.second)];
         }
         bool duplicate = false;
         for (const Tri& t : cand) {
@@ -548,9 +647,14 @@ size_t RetriangulateFlatFolds(const std::vector<Vec3>& vertices, std::vector<Tri
           for (size_t f : patch) own = own || Sorted(faces[f]) == t;
           duplicate = duplicate || (!own && existing.count(t) > 0);
         }
-        return kept_shared && !(duplicate || nm_after > nm_before || open_after > open_before || nm_after + fold_after >= nm_before + fold_before);
+        return kept_shared && !(duplicate || nm_after > nm_before || open_after > open_before + rim_opened || nm_after + fold_after >= nm_before + fold_before);
       };
       bool ok = acceptable(tris);
+      if (!ok) {
+        // A triangulation that keeps the edges shared with the faces around (Delaunay need not have them).
+        tris = GreedyTriangulation(vertices, faces, patch, pv, q, edge_faces, min_quality);
+        ok = !tris.empty() && acceptable(tris);
+      }
       if (!ok) {
         // Fallback: the patch's outline (edges with one patch face) as one simple polygon, ear-clipped best
         // ear first (its interior vertices are dropped).
@@ -756,13 +860,19 @@ TriangleMesh ThinMesh(const Udf& udf, const TriangleMesh& thick, const ThinMeshO
   // 4. Flat folds.
   if (options.fold_flatness_deg > 0.0) {
     st.folds_retriangulated = RetriangulateFlatFolds(thick.vertices, kept, std::cos(options.fold_flatness_deg * M_PI / 180.0),
-                                                      options.degenerate_quality);
+                                                      options.degenerate_quality, false);
     monitor.Info(Count(st.folds_retriangulated, "flat folds re-triangulated"));
   }
   // 5. Triangular holes: three boundary edges that form a cycle are a junction whose face the thinning (or
   // the dual) lost; a true boundary loop of three edges does not occur in a mesh of this resolution.
   st.holes_closed = CloseTriangularHoles(thick.vertices, kept, options.degenerate_quality);
   if (st.holes_closed > 0) monitor.Info(Count(st.holes_closed, "triangular holes closed"));
+  // 6. Folds at open rims, once no other repair applies.
+  if (options.fold_flatness_deg > 0.0) {
+    st.rim_folds_opened = RetriangulateFlatFolds(thick.vertices, kept, std::cos(options.fold_flatness_deg * M_PI / 180.0),
+                                                 options.degenerate_quality, true);
+    if (st.rim_folds_opened > 0) monitor.Info(Count(st.rim_folds_opened, "folds at open rims re-triangulated"));
+  }
   Thinner oriented(std::move(kept), std::vector<double>());
   oriented.OrientComponents();
 

@@ -41,6 +41,7 @@ struct ThinMeshStats {
   size_t small_components_left = 0; ///< small components whose removal would have opened a hole
   size_t folds_retriangulated = 0;   ///< step 4: patches around flat non-manifold edges replaced
   size_t holes_closed = 0;           ///< step 5: cycles of three boundary edges given their face
+  size_t rim_folds_opened = 0;       ///< step 6: patches around folds at open rims replaced
   int rounds = 0;                   ///< rounds of (tetrahedra, components) until nothing changed
 };
 
@@ -65,12 +66,15 @@ struct ThinMeshStats {
 ///     then each cluster of vertices joined by such edges, the faces touching it (or only those within
 ///     fold_flatness_deg of the fold's plane when that star is not flat) are replaced by the 2-D Delaunay
 ///     triangles of their vertices projected on their best-fit plane (inside the projected patch), or else
-///     by ear clipping of the patch's outline, when all patch faces are within fold_flatness_deg of that
+///     by a greedy triangulation keeping the edges shared with the faces around, or by ear clipping of the
+///     patch's outline, when all patch faces are within fold_flatness_deg of that
 ///     plane, the edges shared with faces outside the patch stay, and the result has fewer non-manifold +
 ///     folded edges, no more non-manifold and no more boundary edges. Branching edges (sheets meeting at an
 ///     angle) are not flat and stay.
 ///  5. Every cycle of three boundary edges without its face gets that face (a junction lost by the dual or by
-///     steps 1–4). Unreferenced vertices are dropped (order kept).
+///     steps 1–4).
+///  6. Step 4 again, where a folded edge between two boundary vertices may become a boundary edge (a fold at
+///     an open rim). Unreferenced vertices are dropped (order kept).
 ///
 /// \param udf    the field, for the centroid values
 /// \param thick  vertices + faces with valid indices (the caller validates them)
