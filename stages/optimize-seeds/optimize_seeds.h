@@ -21,7 +21,8 @@ struct OptimizeSeedsOptions {
   double rank_threshold = 0.4;    ///< τ: rank(A) = #{singular values > τ·s_1} (--rank-threshold)
   int cell_knn = 6;               ///< the cell's bounding ball has radius cell_radius_factor × distance to the k-th nearest seed (--cell-knn)
   double cell_radius_factor = 0.5;///< (--cell-radius-factor)
-  double sigma_max_spacing = 0.5; ///< σ ≤ this × mean nearest-neighbour distance; 0: the paper's rule alone (--sigma-max-spacing)
+  double sigma_max_spacing = 0.5; ///< σ ≤ this × mean nearest-neighbour distance; 0: no cap (--sigma-max-spacing)
+  double sigma_min_spacing = 0.5; ///< σ ≥ this × mean nearest-neighbour distance; 0: the paper's rule alone (--sigma-min-spacing)
   double max_step = 0.5;          ///< trust region: a repulsion round moves a seed at most this many σ (--max-step)
   double repulsion_cutoff = 3.0;  ///< neighbours interact within this many σ (kernel 1.1e-2 at 3σ) (--repulsion-cutoff)
   double l1_tol_rel = 1e-6;       ///< L1 step solved to this position accuracy, relative to the diagonal (--l1-tol-rel)
@@ -52,8 +53,8 @@ struct OuterIterationReport {
 /// particle_proj). Input seeds are first projected onto the zero set (seeds that do not converge and exact
 /// duplicates are dropped, with a warning). Then, per outer iteration: (1) the constrained L1 tangent step
 /// of every seed inside its Voronoi cell (l1_tangent.h), then projection; (2) σ = the minimum distance
-/// between seeds, over pairs with at least one movable (rank < 3) seed, capped at sigma_max_spacing × the
-/// mean nearest-neighbour distance; (3) inner rounds of: cells and samples recomputed (voronoi_cells.h),
+/// between seeds, over pairs with at least one movable (rank < 3) seed, kept within [sigma_min_spacing,
+/// sigma_max_spacing] × the mean nearest-neighbour distance; (3) inner rounds of: cells and samples recomputed (voronoi_cells.h),
 /// rank and null space V₀ of every seed's tangent-plane matrix, Gaussian repulsion over neighbours within
 /// repulsion_cutoff·σ minimised with L-BFGS in the null spaces (repulsion.h, trust region max_step·σ),
 /// projection — until the projected gradient's norm changes by less than δ relatively, or
