@@ -15,7 +15,7 @@ struct OptimizeSeedsOptions {
   int samples_per_cell = 100;     ///< M, samples per Voronoi cell (paper: 100) (--samples-per-cell)
   double gamma = 10.0;            ///< γ, proximity weight, lengths relative to the domain diagonal (paper: 10) (--gamma)
   double delta = 1e-3;            ///< δ, inner loop stops when the gradient changes by less than this, relatively (paper: 1e-3) (--delta)
-  int max_outer_iters = 10;       ///< cap on Alg. 1's outer loop (--max-outer-iters)
+  int max_outer_iters = 3;        ///< cap on Alg. 1's outer loop (--max-outer-iters; see docs for why 3)
   int max_inner_iters = 10;       ///< cap on Alg. 1's inner loop (--max-inner-iters)
   int lbfgs_max_iters = 50;       ///< L-BFGS iterations per inner round (Ceres' default) (--lbfgs-max-iters)
   double rank_threshold = 0.4;    ///< τ: rank(A) = #{singular values > τ·s_1} (--rank-threshold)
