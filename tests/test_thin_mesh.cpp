@@ -245,6 +245,31 @@ TEST(ThinMesh, ATriangularHoleIsClosedButNotTheOutline) {
   EXPECT_EQ(ThinMesh(*udf, tri, MinFaces(1), Monitor::Null()).faces.size(), 1u);
 }
 
+TEST(ThinMesh, ANotchAtABranchingLineIsClosed) {
+  const auto udf = MakeShape("disc");
+  TriangleMesh m;
+  AddGrid(m, 6, 6);  // vertex (i, j) is j * 7 + i; row j = 3 is the line y = 0
+  // A vertical fin standing on row 3 makes its edges branching (3 faces). The grid face (2,2)-(3,3)-(2,3)
+  // is missing: vertex (2,2) has boundary edges to (3,3) and (2,3), whose edge keeps the fin's face and the
+  // grid face above it. Step 5 puts the face back; the fin is untouched.
+  const int base = static_cast<int>(m.vertices.size());
+  for (int i = 0; i <= 6; ++i) m.vertices.push_back({-0.3 + 0.1 * i, 0.0, 0.1});
+  for (int i = 0; i < 6; ++i) {
+    m.faces.push_back({21 + i, 22 + i, base + i + 1});
+    m.faces.push_back({21 + i, base + i + 1, base + i});
+  }
+  const int v22 = 16, v33 = 24, v23 = 23;
+  m.faces.erase(std::find(m.faces.begin(), m.faces.end(), Tri{v22, v33, v23}));
+  ThinMeshStats stats;
+  const TriangleMesh out = ThinMesh(*udf, m, ThinMeshOptions{}, Monitor::Null(), &stats);
+  EXPECT_EQ(stats.holes_closed, 1u);
+  EXPECT_TRUE(SortedFaces(out).count({v22, v23, v33}));
+  const TopologyStats topo = ComputeTopology(out);
+  EXPECT_EQ(topo.boundary_edges, 24u + 8u);  // the grid's outline and the fin's three free sides
+  EXPECT_EQ(topo.nonmanifold_edges, 6u);     // row 3
+  EXPECT_EQ(out.faces.size(), 72u + 12u);
+}
+
 TEST(ThinMesh, AFoldAtAnOpenRimBecomesBoundary) {
   const auto udf = MakeShape("disc");
   TriangleMesh m;

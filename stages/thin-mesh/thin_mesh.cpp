@@ -678,35 +678,59 @@ size_t RetriangulateFlatFolds(const std::vector<Vec3>& vertices, std::vector<Tri
   return replaced;
 }
 
-/// Step 5: adds the face of every cycle of three boundary edges (edges with one face) whose triangle is not a
-/// face yet and is not degenerate. Returns the number added.
-size_t CloseTriangularHoles(const std::vector<Vec3>& vertices, std::vector<Tri>& faces, double min_quality) {
-  const EdgeFaces ef = BuildEdgeFaces(faces);
-  std::map<int, std::vector<int>> open;  // vertex -> its neighbours along boundary edges
-  for (size_t e = 0; e < ef.edges.size(); ++e)
-    if (ef.faces[e].size() == 1) {
-      open[ef.edges[e][0]].push_back(ef.edges[e][1]);
-      open[ef.edges[e][1]].push_back(ef.edges[e][0]);
+/// Step 5: adds the face (a, b, c) wherever b has boundary edges (edges with one face) to a and to c and the
+/// third side a-c is an edge too, either a boundary edge (a triangular hole) or one with faces (a notch
+/// next to a branching curve or a sheet), unless the triangle is degenerate or would lie over a face of
+/// one of its edges (third vertices within acos(min_cos) of each other seen from the edge: at an open rim
+/// that is the face already there). Returns the number added.
+size_t CloseTriangularHoles(const std::vector<Vec3>& vertices, std::vector<Tri>& faces, double min_quality,
+                            double min_cos) {
+  std::map<std::pair<int, int>, std::vector<int>> third;  // edge -> the third vertices of its faces
+  for (const Tri& t : faces)
+    for (int k = 0; k < 3; ++k) {
+      const int u = t[static_cast<size_t>(k)], v = t[static_cast<size_t>((k + 1) % 3)];
+      third[{std::min(u, v), std::max(u, v)}].push_back(t[static_cast<size_t>((k + 2) % 3)]);
     }
-  std::set<Tri> existing;
-  for (const Tri& t : faces) existing.insert(Sorted(t));
+  std::map<int, std::vector<int>> open;  // vertex -> its neighbours along boundary edges
+  for (const auto& [e, w] : third)
+    if (w.size() == 1) {
+      open[e.first].push_back(e.second);
+      open[e.second].push_back(e.first);
+    }
+  auto at = [&](int v) -> const Vec3& { return vertices[static_cast<size_t>(v)]; };
+  // Whether a face (u, v, w) would lie over a face of edge u-v.
+  auto over = [&](int u, int v, int w) {
+    const auto it = third.find({std::min(u, v), std::max(u, v)});
+    if (it == third.end()) return false;
+    const Vec3 axis = (at(v) - at(u)).normalized();
+    auto perp = [&](int x) {
+      Vec3 d = at(x) - at(u);
+      d -= d.dot(axis) * axis;
+      return Vec3(d.normalized());
+    };
+    for (int z : it->second)
+      if (perp(w).dot(perp(z)) >= min_cos) return true;
+    return false;
+  };
   size_t added = 0;
-  for (auto& [a, na] : open) std::sort(na.begin(), na.end());
-  for (const auto& [a, na] : open)
-    for (int b : na) {
-      if (b <= a) continue;
-      for (int c : open[b]) {
-        if (c <= b || !std::binary_search(na.begin(), na.end(), c)) continue;
-        const Tri t{a, b, c};
-        if (existing.count(t)) continue;
-        const double q = TriangleQuality(vertices[static_cast<size_t>(a)], vertices[static_cast<size_t>(b)],
-                                         vertices[static_cast<size_t>(c)]);
-        if (!(q >= min_quality) || q == 0.0) continue;
+  std::set<Tri> done;
+  for (auto& [b, nb] : open) {
+    std::sort(nb.begin(), nb.end());
+    for (size_t i = 0; i < nb.size(); ++i)
+      for (size_t j = i + 1; j < nb.size(); ++j) {
+        const int a = nb[i], c = nb[j];
+        if (!third.count({std::min(a, c), std::max(a, c)})) continue;
+        const Tri t = Sorted({a, b, c});
+        if (!done.insert(t).second) continue;
+        bool exists = false;
+        for (int w : third[{std::min(a, c), std::max(a, c)}]) exists = exists || w == b;
+        if (exists) continue;
+        const double q = TriangleQuality(at(a), at(b), at(c));
+        if (!(q >= min_quality) || q == 0.0 || over(a, b, c) || over(b, c, a) || over(a, c, b)) continue;
         faces.push_back(t);
-        existing.insert(t);
         ++added;
       }
-    }
+  }
   return added;
 }
 
@@ -865,7 +889,8 @@ TriangleMesh ThinMesh(const Udf& udf, const TriangleMesh& thick, const ThinMeshO
   }
   // 5. Triangular holes: three boundary edges that form a cycle are a junction whose face the thinning (or
   // the dual) lost; a true boundary loop of three edges does not occur in a mesh of this resolution.
-  st.holes_closed = CloseTriangularHoles(thick.vertices, kept, options.degenerate_quality);
+  st.holes_closed = CloseTriangularHoles(thick.vertices, kept, options.degenerate_quality,
+                                         std::cos(options.fold_flatness_deg * M_PI / 180.0));
   if (st.holes_closed > 0) monitor.Info(Count(st.holes_closed, "triangular holes closed"));
   // 6. Folds at open rims, once no other repair applies.
   if (options.fold_flatness_deg > 0.0) {

@@ -40,7 +40,7 @@ struct ThinMeshStats {
   size_t component_faces_removed = 0;
   size_t small_components_left = 0; ///< small components whose removal would have opened a hole
   size_t folds_retriangulated = 0;   ///< step 4: patches around flat non-manifold edges replaced
-  size_t holes_closed = 0;           ///< step 5: cycles of three boundary edges given their face
+  size_t holes_closed = 0;           ///< step 5: triangular holes and notches given their face
   size_t rim_folds_opened = 0;       ///< step 6: patches around folds at open rims replaced
   int rounds = 0;                   ///< rounds of (tetrahedra, components) until nothing changed
 };
@@ -71,8 +71,9 @@ struct ThinMeshStats {
 ///     plane, the edges shared with faces outside the patch stay, and the result has fewer non-manifold +
 ///     folded edges, no more non-manifold and no more boundary edges. Branching edges (sheets meeting at an
 ///     angle) are not flat and stay.
-///  5. Every cycle of three boundary edges without its face gets that face (a junction lost by the dual or by
-///     steps 1–4).
+///  5. Where a vertex b has boundary edges to a and c and a-c is an edge (a triangular hole, or a notch at a
+///     branching curve), the face (a, b, c) is added unless it is degenerate or lies over a face of one of
+///     its edges (a junction lost by the dual or by steps 1–4).
 ///  6. Step 4 again, where a folded edge between two boundary vertices may become a boundary edge (a fold at
 ///     an open rim). Unreferenced vertices are dropped (order kept).
 ///
