@@ -80,7 +80,7 @@ struct ThinMeshStats {
 /// \param udf    the field, for the centroid values
 /// \param thick  vertices + faces with valid indices (the caller validates them)
 /// \param stats  optional counts
-/// Deterministic (faces keep their input order, step 4's new faces last), independent of the thread count.
+/// Deterministic (faces keep their input order, the faces made by steps 4–6 last), independent of the thread count.
 TriangleMesh ThinMesh(const Udf& udf, const TriangleMesh& thick, const ThinMeshOptions& options, Monitor& monitor,
                       ThinMeshStats* stats = nullptr);
 
