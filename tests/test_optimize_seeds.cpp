@@ -498,6 +498,13 @@ void ExpectRankTwoOnFeatures(const std::string& shape, const std::function<doubl
   }
   EXPECT_GE(static_cast<double>(on_feature), 0.9 * static_cast<double>(rank2)) << shape;
   EXPECT_GE(on_curve, min_on_curve) << shape;
+  // Feature clearance: no sheet seed beside a feature seed (the limit is taken on the spacing before the
+  // drop, which the few dropped seeds change by well under 10 %).
+  for (size_t i = 0; i < out.size(); ++i)
+    for (size_t j = 0; j < out.size() && out.rank[i] < 2; ++j)
+      if (out.rank[j] >= 2) {
+        EXPECT_GE((out.position[i] - out.position[j]).norm(), 0.9 * options.feature_clearance * mean_nn) << shape;
+      }
   EXPECT_LT(cv_out, NearestNeighbourCv(in.position) / cv_factor) << shape;
 }
 
@@ -522,6 +529,19 @@ TEST(OptimizeSeeds, SphereWithDiscRankTwoSeedsOnTheEquator) {
 // The stopping rules fire before the caps: the inner loop at the first round whose projected gradient
 // does not decrease by δ, the outer loop at the first iteration where σ stops growing and the spacing
 // CV improves by less than outer_tol (and not before it).
+TEST(OptimizeSeeds, SheetSeedsBesideAFeatureSeedAreDropped) {
+  SeedCloud in;
+  in.Resize(5);
+  in.position = {{0, 0, 0}, {0.05, 0, 0}, {0.02, 0.01, 0}, {0.3, 0, 0}, {0.3, 0.02, 0}};
+  in.rank = {2, 2, 1, 1, 3};  // a sheet seed beside the curve, a sheet seed far from it, a corner
+  const SeedCloud out = DropSeedsBesideFeatures(in, 0.03, Monitor::Null());
+  ASSERT_EQ(out.size(), 3u);  // seed 2 (0.022 from seed 0) and seed 3 (0.02 from the corner) go
+  EXPECT_EQ(out.position[0], in.position[0]);
+  EXPECT_EQ(out.position[1], in.position[1]);  // feature seeds stay, however close to each other
+  EXPECT_EQ(out.position[2], in.position[4]);
+  EXPECT_EQ(DropSeedsBesideFeatures(in, 0.01, Monitor::Null()).size(), 5u);
+}
+
 TEST(OptimizeSeeds, StoppingRulesEndTheLoopsBeforeTheirCaps) {
   const auto sphere = MakeShape("sphere");
   const SeedCloud in = Initial(*sphere, 500, 5);
@@ -554,6 +574,12 @@ TEST(OptimizeSeeds, BadOptionsAndInputs) {
   EXPECT_THROW(o.Check(), UsageError);
   o = OptimizeSeedsOptions();
   o.rank_threshold = 1.5;
+  EXPECT_THROW(o.Check(), UsageError);
+  o = OptimizeSeedsOptions();
+  o.feature_clearance = 2;
+  EXPECT_THROW(o.Check(), UsageError);
+  o = OptimizeSeedsOptions();
+  o.sigma_min_spacing = 0.8;  // above the cap of 0.5
   EXPECT_THROW(o.Check(), UsageError);
   const auto sphere = MakeShape("sphere");
   SeedCloud one;

@@ -28,6 +28,7 @@ void OptimizeSeedsOptions::Check() const {
   if (!(max_step >= 0.0 && max_step <= 100.0)) throw UsageError("--max-step must be in [0, 100]");
   if (!(sigma_max_spacing >= 0.0 && sigma_max_spacing <= 10.0)) throw UsageError("--sigma-max-spacing must be in [0, 10]");
   if (!(sigma_min_spacing >= 0.0 && sigma_min_spacing <= 10.0)) throw UsageError("--sigma-min-spacing must be in [0, 10]");
+  if (!(feature_clearance >= 0.0 && feature_clearance <= 1.0)) throw UsageError("--feature-clearance must be in [0, 1]");
   if (sigma_max_spacing > 0.0 && sigma_min_spacing > sigma_max_spacing)
     throw UsageError("--sigma-min-spacing must not exceed --sigma-max-spacing");
   if (!(repulsion_cutoff >= 1.0 && repulsion_cutoff <= 10.0)) throw UsageError("--repulsion-cutoff must be in [1, 10]");
@@ -382,6 +383,30 @@ State Prepare(const Udf& udf, const SeedCloud& input, const ProjectionOptions& p
 
 }  // namespace
 
+SeedCloud DropSeedsBesideFeatures(const SeedCloud& in, double limit, Monitor& monitor) {
+  std::vector<Vec3> feature;
+  for (size_t i = 0; i < in.size(); ++i)
+    if (in.rank[i] >= 2) feature.push_back(in.position[i]);
+  if (feature.empty()) return in;
+  const SeedIndex index(feature);
+  SeedCloud out;
+  std::vector<int> found;
+  for (size_t i = 0; i < in.size(); ++i) {
+    if (in.rank[i] < 2) {
+      index.WithinRadius(in.position[i], limit, found);
+      if (!found.empty()) continue;
+    }
+    out.position.push_back(in.position[i]);
+    out.normal.push_back(in.normal[i]);
+    out.udf.push_back(in.udf[i]);
+    out.rank.push_back(in.rank[i]);
+  }
+  if (out.size() < in.size())
+    monitor.Info(std::to_string(in.size() - out.size()) + " sheet seeds dropped: nearer than " + Format("%.3g", limit) +
+                 " to a seed on a feature");
+  return out;
+}
+
 SeedCloud OptimizeSeeds(const Udf& udf, const SeedCloud& input, const OptimizeSeedsOptions& options, Monitor& monitor,
                         const std::function<void(const OuterIterationReport&, const SeedCloud&)>& on_iteration) {
   options.Check();
@@ -500,7 +525,9 @@ SeedCloud OptimizeSeeds(const Udf& udf, const SeedCloud& input, const OptimizeSe
                "ranks 0/1/2/3: " + std::to_string(final_report.rank_count[0]) + "/" +
                std::to_string(final_report.rank_count[1]) + "/" + std::to_string(final_report.rank_count[2]) + "/" +
                std::to_string(final_report.rank_count[3]));
-  return ToCloud(s);
+  SeedCloud out = ToCloud(s);
+  if (options.feature_clearance > 0.0) out = DropSeedsBesideFeatures(out, options.feature_clearance * opt.MeanSpacing(out.position), monitor);
+  return out;
 }
 
 }  // namespace voroudf

@@ -23,6 +23,9 @@ struct OptimizeSeedsOptions {
   double cell_radius_factor = 0.5;///< (--cell-radius-factor)
   double sigma_max_spacing = 0.5; ///< σ ≤ this × mean nearest-neighbour distance; 0: no cap (--sigma-max-spacing)
   double sigma_min_spacing = 0.5; ///< σ ≥ this × mean nearest-neighbour distance; 0: the paper's rule alone (--sigma-min-spacing)
+  /// At the end, sheet seeds (rank < 2) nearer than this × the mean nearest-neighbour distance to a seed on a
+  /// feature (rank ≥ 2) are dropped (--feature-clearance; 0: none). Not in the paper.
+  double feature_clearance = 0.4;
   double max_step = 0.5;          ///< trust region: a repulsion round moves a seed at most this many σ (--max-step)
   double repulsion_cutoff = 3.0;  ///< neighbours interact within this many σ (kernel 1.1e-2 at 3σ) (--repulsion-cutoff)
   double l1_tol_rel = 1e-6;       ///< L1 step solved to this position accuracy, relative to the diagonal (--l1-tol-rel)
@@ -49,6 +52,12 @@ struct OuterIterationReport {
   double seconds = 0.0;
 };
 
+/// Drops every sheet seed (rank < 2) nearer than `limit` to a seed on a feature (rank ≥ 2); the others keep
+/// their order. Why (not in the paper): such a seed's geodesic region reaches the feature curve between the
+/// curve's seeds, and the dual then gets faces from it across the curve to the other sheets, i.e. folds
+/// beside a branching curve (docs/optimize-seeds.md, "Feature clearance"). Logs the count dropped.
+SeedCloud DropSeedsBesideFeatures(const SeedCloud& in, double limit, Monitor& monitor);
+
 /// Paper Alg. 1 lines 2–16 (Sec. 3.1 Eqs. energy_l1 / energy_l1_regularizer, Sec. 3.2 Eqs. particle /
 /// particle_proj). Input seeds are first projected onto the zero set (seeds that do not converge and exact
 /// duplicates are dropped, with a warning). Then, per outer iteration: (1) the constrained L1 tangent step
@@ -67,6 +76,7 @@ struct OuterIterationReport {
 /// \param options       see OptimizeSeedsOptions; checked first (UsageError)
 /// \param monitor       logs one line per outer iteration and a progress task per outer iteration
 /// \param on_iteration  optional: sees the seeds after every outer iteration (for --trace)
+/// Finally, sheet seeds within feature_clearance × the mean spacing of a feature seed are dropped.
 /// \return seeds on the zero set (d < proj_tol_rel·diagonal) with UDF value, gradient and rank, in input
 ///         order. Deterministic for given inputs and options, also across thread counts (fixed-order
 ///         reductions, per-seed random streams). Throws InputError for fewer than 2 distinct seeds,
