@@ -276,6 +276,22 @@ bool InsidePatch(const std::vector<Tri>& faces, const std::vector<size_t>& patch
   return false;
 }
 
+/// Whether a face of triangle quality `quality` counts as degenerate (below `min_quality`, or of zero area).
+bool IsDegenerate(double quality, double min_quality) { return !(quality >= min_quality) || quality == 0.0; }
+
+/// Whether the faces (u, v, x) and (u, v, z) lie on the same side of their edge u-v, nearly coplanar: the
+/// perpendiculars from the edge to x and to z within acos(min_cos) of each other.
+bool SameSideOfEdge(const std::vector<Vec3>& vertices, int u, int v, int x, int z, double min_cos) {
+  const Vec3& pu = vertices[static_cast<size_t>(u)];
+  const Vec3 axis = (vertices[static_cast<size_t>(v)] - pu).normalized();
+  auto perp = [&](int w) {
+    Vec3 d = vertices[static_cast<size_t>(w)] - pu;
+    d -= d.dot(axis) * axis;
+    return d.norm() > 0.0 ? Vec3(d.normalized()) : d;
+  };
+  return perp(x).dot(perp(z)) >= min_cos;
+}
+
 /// Ear clipping of the outline of `patch` (its edges used by one patch face, which must form one simple
 /// cycle) in the 2-D coordinates `q`: best ear (triangle quality) first. Empty when that fails.
 std::vector<Tri> EarClip(const std::vector<Vec3>& vertices, const std::vector<size_t>& patch, const std::vector<Tri>& faces,
@@ -307,9 +323,8 @@ std::vector<Tri> EarClip(const std::vector<Vec3>& vertices, const std::vector<si
   }
   if (poly.size() != next.size()) return {};
   auto at = [&](int v) { return q.at(v); };
-  const auto cross2 = Cross2;
   double area = 0.0;
-  for (size_t i = 0; i < poly.size(); ++i) area += cross2(Eigen::Vector2d::Zero(), at(poly[i]), at(poly[(i + 1) % poly.size()]));
+  for (size_t i = 0; i < poly.size(); ++i) area += Cross2(Eigen::Vector2d::Zero(), at(poly[i]), at(poly[(i + 1) % poly.size()]));
   if (area < 0.0) std::reverse(poly.begin(), poly.end());
   std::vector<Tri> out;
   while (poly.size() > 3) {
@@ -317,11 +332,11 @@ std::vector<Tri> EarClip(const std::vector<Vec3>& vertices, const std::vector<si
     double best_q = -1.0;
     for (size_t i = 0; i < poly.size(); ++i) {
       const int p0 = poly[(i + poly.size() - 1) % poly.size()], p1 = poly[i], p2 = poly[(i + 1) % poly.size()];
-      if (!(cross2(at(p0), at(p1), at(p2)) > 0.0)) continue;
+      if (!(Cross2(at(p0), at(p1), at(p2)) > 0.0)) continue;
       bool empty = true;
       for (int v : poly) {
         if (v == p0 || v == p1 || v == p2) continue;
-        if (cross2(at(p0), at(p1), at(v)) >= 0 && cross2(at(p1), at(p2), at(v)) >= 0 && cross2(at(p2), at(p0), at(v)) >= 0)
+        if (Cross2(at(p0), at(p1), at(v)) >= 0 && Cross2(at(p1), at(p2), at(v)) >= 0 && Cross2(at(p2), at(p0), at(v)) >= 0)
           empty = false;
       }
       if (!empty) continue;
@@ -332,13 +347,13 @@ std::vector<Tri> EarClip(const std::vector<Vec3>& vertices, const std::vector<si
         best = i;
       }
     }
-    if (best == poly.size() || !(best_q >= min_quality) || best_q == 0.0) return {};
+    if (best == poly.size() || IsDegenerate(best_q, min_quality)) return {};
     out.push_back(Sorted({poly[(best + poly.size() - 1) % poly.size()], poly[best], poly[(best + 1) % poly.size()]}));
     poly.erase(poly.begin() + static_cast<long>(best));
   }
   const double quality = TriangleQuality(vertices[static_cast<size_t>(poly[0])], vertices[static_cast<size_t>(poly[1])],
                                          vertices[static_cast<size_t>(poly[2])]);
-  if (!(cross2(at(poly[0]), at(poly[1]), at(poly[2])) > 0.0) || !(quality >= min_quality) || quality == 0.0) return {};
+  if (!(Cross2(at(poly[0]), at(poly[1]), at(poly[2])) > 0.0) || IsDegenerate(quality, min_quality)) return {};
   out.push_back(Sorted({poly[0], poly[1], poly[2]}));
   return out;
 }
@@ -354,7 +369,6 @@ std::vector<Tri> GreedyTriangulation(const std::vector<Vec3>& vertices, const st
                                      std::unordered_map<int, Eigen::Vector2d>& q,
                                      const std::map<std::pair<int, int>, std::vector<Tri>>& edge_faces,
                                      double min_quality) {
-  const auto cross2 = Cross2;
   auto inside = [&](const Eigen::Vector2d& c) { return InsidePatch(faces, patch, q, c); };
   auto key = [](int u, int v) { return std::make_pair(std::min(u, v), std::max(u, v)); };
   std::set<Tri> own;
@@ -371,14 +385,14 @@ std::vector<Tri> GreedyTriangulation(const std::vector<Vec3>& vertices, const st
     const Eigen::Vector2d &A = q[a], &B = q[b];
     for (const auto& [c, d] : taken) {
       if (c == a || c == b || d == a || d == b) continue;
-      const double d1 = cross2(A, B, q[c]), d2 = cross2(A, B, q[d]), d3 = cross2(q[c], q[d], A), d4 = cross2(q[c], q[d], B);
+      const double d1 = Cross2(A, B, q[c]), d2 = Cross2(A, B, q[d]), d3 = Cross2(q[c], q[d], A), d4 = Cross2(q[c], q[d], B);
       if (((d1 > 0 && d2 < 0) || (d1 < 0 && d2 > 0)) && ((d3 > 0 && d4 < 0) || (d3 < 0 && d4 > 0))) return true;
     }
     const double len2 = (B - A).squaredNorm();
     for (int v : pv) {  // through another vertex
       if (v == a || v == b) continue;
       const double t = (q[v] - A).dot(B - A) / len2;
-      if (t > 0 && t < 1 && std::abs(cross2(A, B, q[v])) < 1e-9 * len2) return true;
+      if (t > 0 && t < 1 && std::abs(Cross2(A, B, q[v])) < 1e-9 * len2) return true;
     }
     return false;
   };
@@ -413,13 +427,13 @@ std::vector<Tri> GreedyTriangulation(const std::vector<Vec3>& vertices, const st
         bool empty = true;
         for (int v : pv) {
           if (v == a || v == b || v == c) continue;
-          const double d0 = cross2(A, B, q[v]), d1 = cross2(B, C, q[v]), d2 = cross2(C, A, q[v]);
+          const double d0 = Cross2(A, B, q[v]), d1 = Cross2(B, C, q[v]), d2 = Cross2(C, A, q[v]);
           empty = empty && !((d0 > 0 && d1 > 0 && d2 > 0) || (d0 < 0 && d1 < 0 && d2 < 0));
         }
         if (!empty || !inside((A + B + C) / 3.0)) continue;
         const double quality = TriangleQuality(vertices[static_cast<size_t>(a)], vertices[static_cast<size_t>(b)],
                                                vertices[static_cast<size_t>(c)]);
-        if (!(quality >= min_quality) || quality == 0.0) return {};
+        if (IsDegenerate(quality, min_quality)) return {};
         out.push_back({a, b, c});
       }
     }
@@ -444,17 +458,10 @@ size_t RetriangulateFlatFolds(const std::vector<Vec3>& vertices, std::vector<Tri
   // Two faces of edge e on the same side of it, nearly coplanar: their third vertices' perpendiculars from
   // the edge within acos(min_cos).
   auto folded = [&](const Edge& e, const std::vector<Tri>& fs) {
-    const Vec3& pa = vertices[static_cast<size_t>(e.first)];
-    const Vec3 t = (vertices[static_cast<size_t>(e.second)] - pa).normalized();
-    std::vector<Vec3> perp;
-    for (const Tri& f : fs) {
-      Vec3 v = vertices[static_cast<size_t>(f[0] + f[1] + f[2] - e.first - e.second)] - pa;
-      v -= v.dot(t) * t;
-      perp.push_back(v.norm() > 0.0 ? Vec3(v.normalized()) : v);
-    }
-    for (size_t i = 0; i < perp.size(); ++i)
-      for (size_t j = i + 1; j < perp.size(); ++j)
-        if (perp[i].dot(perp[j]) >= min_cos) return true;
+    auto third = [&](const Tri& f) { return f[0] + f[1] + f[2] - e.first - e.second; };
+    for (size_t i = 0; i < fs.size(); ++i)
+      for (size_t j = i + 1; j < fs.size(); ++j)
+        if (SameSideOfEdge(vertices, e.first, e.second, third(fs[i]), third(fs[j]), min_cos)) return true;
     return false;
   };
   size_t replaced = 0;
@@ -570,14 +577,13 @@ size_t RetriangulateFlatFolds(const std::vector<Vec3>& vertices, std::vector<Tri
       const Vec3 w = mean.cross(u);
       std::unordered_map<int, Eigen::Vector2d> q;
       for (int v : pv) q[v] = Eigen::Vector2d(vertices[static_cast<size_t>(v)].dot(u), vertices[static_cast<size_t>(v)].dot(w));
-      const auto cross2 = Cross2;
       auto inside_patch = [&](const Eigen::Vector2d& c) { return InsidePatch(faces, patch, q, c); };
       std::vector<Tri> tris;
       for (size_t i = 0; i < pv.size(); ++i)
         for (size_t j = i + 1; j < pv.size(); ++j)
           for (size_t k = j + 1; k < pv.size(); ++k) {
             const Eigen::Vector2d &A = q[pv[i]], &B = q[pv[j]], &C = q[pv[k]];
-            const double area2 = cross2(A, B, C);
+            const double area2 = Cross2(A, B, C);
             if (std::abs(area2) < 1e-12 * ((B - A).squaredNorm() + (C - A).squaredNorm())) continue;
             bool empty = true;
             for (size_t m = 0; m < pv.size() && empty; ++m) {
@@ -592,11 +598,11 @@ size_t RetriangulateFlatFolds(const std::vector<Vec3>& vertices, std::vector<Tri
             if (!empty || !inside_patch((A + B + C) / 3.0)) continue;
             const double quality = TriangleQuality(vertices[static_cast<size_t>(pv[i])], vertices[static_cast<size_t>(pv[j])],
                                                    vertices[static_cast<size_t>(pv[k])]);
-            if (quality >= min_quality && quality > 0.0) tris.push_back({pv[i], pv[j], pv[k]});
+            if (!IsDegenerate(quality, min_quality)) tris.push_back({pv[i], pv[j], pv[k]});
           }
       auto acceptable = [&](const std::vector<Tri>& cand) {
         // The patch's edges before and after; accept when non-manifold plus folded edges drop, with no more
-        // non-manifold and no more boundary edges.
+        // non-manifold and no more boundary edges (beyond the rim folds opened, with `open_rim_folds`).
         std::map<Edge, std::vector<Tri>> after;
         for (size_t f : patch)
           for (int k = 0; k < 3; ++k) {
@@ -702,14 +708,8 @@ size_t CloseTriangularHoles(const std::vector<Vec3>& vertices, std::vector<Tri>&
   auto over = [&](int u, int v, int w) {
     const auto it = third.find({std::min(u, v), std::max(u, v)});
     if (it == third.end()) return false;
-    const Vec3 axis = (at(v) - at(u)).normalized();
-    auto perp = [&](int x) {
-      Vec3 d = at(x) - at(u);
-      d -= d.dot(axis) * axis;
-      return Vec3(d.normalized());
-    };
     for (int z : it->second)
-      if (perp(w).dot(perp(z)) >= min_cos) return true;
+      if (SameSideOfEdge(vertices, u, v, w, z, min_cos)) return true;
     return false;
   };
   size_t added = 0;
@@ -726,7 +726,7 @@ size_t CloseTriangularHoles(const std::vector<Vec3>& vertices, std::vector<Tri>&
         for (int w : third[{std::min(a, c), std::max(a, c)}]) exists = exists || w == b;
         if (exists) continue;
         const double q = TriangleQuality(at(a), at(b), at(c));
-        if (!(q >= min_quality) || q == 0.0 || over(a, b, c) || over(b, c, a) || over(a, c, b)) continue;
+        if (IsDegenerate(q, min_quality) || over(a, b, c) || over(b, c, a) || over(a, c, b)) continue;
         faces.push_back(t);
         ++added;
       }
@@ -766,7 +766,7 @@ TriangleMesh ThinMesh(const Udf& udf, const TriangleMesh& thick, const ThinMeshO
       continue;
     }
     const double quality = quality_of(t);
-    if (!(quality >= options.degenerate_quality) || quality == 0.0) {
+    if (IsDegenerate(quality, options.degenerate_quality)) {
       ++st.degenerate_faces;
       int far = 0;  // the vertex opposite the longest edge is the middle one
       double longest = -1.0;
