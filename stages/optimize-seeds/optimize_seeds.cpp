@@ -519,14 +519,15 @@ SeedCloud OptimizeSeeds(const Udf& udf, const SeedCloud& input, const OptimizeSe
   opt.Analyze(s);
   OuterIterationReport final_report;
   CountRanks(s, final_report);
+  const auto [spacing_out, cv_out] = opt.SpacingStats(s.position);
   monitor.Info(Format("done in %.2f s; mean |udf| %.3g (rel); spacing CV %.3f -> %.3f; ",
                       std::chrono::duration<double>(Clock::now() - start).count(), final_report.mean_abs_udf / opt.diagonal(),
-                      cv_in, opt.SpacingStats(s.position).second) +
+                      cv_in, cv_out) +
                "ranks 0/1/2/3: " + std::to_string(final_report.rank_count[0]) + "/" +
                std::to_string(final_report.rank_count[1]) + "/" + std::to_string(final_report.rank_count[2]) + "/" +
                std::to_string(final_report.rank_count[3]));
   SeedCloud out = ToCloud(s);
-  if (options.feature_clearance > 0.0) out = DropSeedsBesideFeatures(out, options.feature_clearance * opt.MeanSpacing(out.position), monitor);
+  if (options.feature_clearance > 0.0) out = DropSeedsBesideFeatures(out, options.feature_clearance * spacing_out, monitor);
   return out;
 }
 
