@@ -498,12 +498,14 @@ void ExpectRankTwoOnFeatures(const std::string& shape, const std::function<doubl
   }
   EXPECT_GE(static_cast<double>(on_feature), 0.9 * static_cast<double>(rank2)) << shape;
   EXPECT_GE(on_curve, min_on_curve) << shape;
-  // Feature clearance: no sheet seed beside a feature seed (the limit is taken on the spacing before the
-  // drop, which the few dropped seeds change by well under 10 %).
+  // Feature clearance: no seed beside a feature seed, except sheet seeds beside each other (the limit is
+  // taken on the spacing before the drop, which the few dropped seeds change by well under 10 %).
+  auto level = [&](size_t i) { return std::max<int>(out.rank[i], 1); };
   for (size_t i = 0; i < out.size(); ++i)
-    for (size_t j = 0; j < out.size() && out.rank[i] < 2; ++j)
-      if (out.rank[j] >= 2) {
-        EXPECT_GE((out.position[i] - out.position[j]).norm(), 0.9 * options.feature_clearance * mean_nn) << shape;
+    for (size_t j = 0; j < out.size(); ++j)
+      if (j != i && level(j) >= 2) {
+        EXPECT_GE((out.position[i] - out.position[j]).norm(), 0.9 * options.feature_clearance * mean_nn)
+            << shape << ": ranks " << level(i) << " and " << level(j);
       }
   EXPECT_LT(cv_out, NearestNeighbourCv(in.position) / cv_factor) << shape;
 }
@@ -529,17 +531,39 @@ TEST(OptimizeSeeds, SphereWithDiscRankTwoSeedsOnTheEquator) {
 // The stopping rules fire before the caps: the inner loop at the first round whose projected gradient
 // does not decrease by δ, the outer loop at the first iteration where σ stops growing and the spacing
 // CV improves by less than outer_tol (and not before it).
-TEST(OptimizeSeeds, SheetSeedsBesideAFeatureSeedAreDropped) {
-  SeedCloud in;
-  in.Resize(5);
-  in.position = {{0, 0, 0}, {0.05, 0, 0}, {0.02, 0.01, 0}, {0.3, 0, 0}, {0.3, 0.02, 0}};
-  in.rank = {2, 2, 1, 1, 3};  // a sheet seed beside the curve, a sheet seed far from it, a corner
-  const SeedCloud out = DropSeedsBesideFeatures(in, 0.03, Monitor::Null());
-  ASSERT_EQ(out.size(), 3u);  // seed 2 (0.022 from seed 0) and seed 3 (0.02 from the corner) go
-  EXPECT_EQ(out.position[0], in.position[0]);
-  EXPECT_EQ(out.position[1], in.position[1]);  // feature seeds stay, however close to each other
-  EXPECT_EQ(out.position[2], in.position[4]);
-  EXPECT_EQ(DropSeedsBesideFeatures(in, 0.01, Monitor::Null()).size(), 5u);
+TEST(OptimizeSeeds, SeedsBesideAHigherRankedFeatureSeedAreDropped) {
+  const std::vector<Vec3> position = {{0, 0, 0},   {0.05, 0, 0},  {0.02, 0.01, 0}, {0.3, 0, 0},
+                                      {0.3, 0.02, 0}, {0.6, 0, 0}, {0.6, 0.01, 0}, {0.62, 0, 0}};
+  // 0, 1: curve seeds 0.05 apart; 2: a sheet seed beside them; 3: a sheet seed beside corner 4; 5, 6: two
+  // corner seeds 0.01 apart; 7: a curve seed 0.02 from corner 5.
+  const std::vector<uint8_t> rank = {2, 2, 1, 1, 3, 3, 3, 2};
+  EXPECT_EQ(SeedsBesideFeatures(position, rank, 0.03), (std::vector<char>{0, 0, 1, 1, 0, 0, 1, 1}));
+  // The misfit decides which corner seed stays (here 6); seed 7 is within the limit of both corners.
+  EXPECT_EQ(SeedsBesideFeatures(position, rank, 0.03, {0, 0, 0, 0, 0, 0.5, 0.1, 0}),
+            (std::vector<char>{0, 0, 1, 1, 0, 1, 0, 1}));
+  // Curve seeds alone are thinned in input order to the limit; nothing goes at a small enough limit.
+  EXPECT_EQ(SeedsBesideFeatures(position, std::vector<uint8_t>(8, 2), 0.03), (std::vector<char>{0, 0, 1, 0, 1, 0, 1, 1}));
+  EXPECT_EQ(SeedsBesideFeatures(position, rank, 0.005), std::vector<char>(8, 0));
+  // Sheet seeds never crowd each other out.
+  EXPECT_EQ(SeedsBesideFeatures(position, std::vector<uint8_t>(8, 1), 0.03), std::vector<char>(8, 0));
+}
+
+// A sheet seed between two curve seeds lies near the curve though far from both: the segment between them
+// stands for the curve when it runs along their tangents, and not when it cuts across a face.
+TEST(OptimizeSeeds, SheetSeedsBetweenTwoCurveSeedsAreDropped) {
+  const std::vector<Vec3> position = {{0, 0, 0}, {0.05, 0, 0}, {0.025, 0.01, 0},   // along a curve
+                                      {1.05, 0, 0}, {1, 0.05, 0}, {1.03, 0.03, 0}};  // two edges' seeds
+  const std::vector<uint8_t> rank = {2, 2, 1, 2, 2, 1};
+  const Vec3 x = Vec3::UnitX(), y = Vec3::UnitY();
+  const std::vector<Vec3> tangent = {x, x, Vec3::Zero(), x, y, Vec3::Zero()};
+  // Seed 2 is 0.027 from both curve seeds (over the limit 0.02) but 0.01 from the segment between them.
+  EXPECT_EQ(SeedsBesideFeatures(position, rank, 0.02, {}, tangent), (std::vector<char>{0, 0, 1, 0, 0, 0}));
+  EXPECT_EQ(SeedsBesideFeatures(position, rank, 0.02), std::vector<char>(6, 0));
+  // Seed 5 is 0.007 from the segment between seeds 3 and 4, which crosses the face: not a curve, unless
+  // their tangents ran along it.
+  std::vector<Vec3> along = tangent;
+  along[3] = along[4] = (position[4] - position[3]).normalized();
+  EXPECT_EQ(SeedsBesideFeatures(position, rank, 0.02, {}, along), (std::vector<char>{0, 0, 1, 0, 0, 1}));
 }
 
 TEST(OptimizeSeeds, StoppingRulesEndTheLoopsBeforeTheirCaps) {
@@ -616,7 +640,12 @@ TEST_F(OptimizeSeedsExe, WritesSeedsOnTheSurfaceWithRanksAndATrace) {
   EXPECT_TRUE(r.out.empty());
   EXPECT_NE(r.err.find("outer 1:"), std::string::npos) << r.err;
   const SeedCloud seeds = ReadSeeds(out);
-  EXPECT_EQ(seeds.size(), 300u);
+  // A few seeds crowding the curves and the point where the three curves meet are dropped, and said so.
+  EXPECT_GE(seeds.size(), 270u);  // 283 measured
+  EXPECT_LE(seeds.size(), 300u);
+  if (seeds.size() < 300u) {
+    EXPECT_NE(r.err.find(std::to_string(300 - seeds.size()) + " seeds dropped"), std::string::npos) << r.err;
+  }
   const auto udf = MakeShape("three-discs");
   size_t ranked = 0;
   for (size_t i = 0; i < seeds.size(); ++i) {

@@ -23,9 +23,13 @@ struct OptimizeSeedsOptions {
   double cell_radius_factor = 0.5;///< (--cell-radius-factor)
   double sigma_max_spacing = 0.5; ///< σ ≤ this × mean nearest-neighbour distance; 0: no cap (--sigma-max-spacing)
   double sigma_min_spacing = 0.5; ///< σ ≥ this × mean nearest-neighbour distance; 0: the paper's rule alone (--sigma-min-spacing)
-  /// At the end, sheet seeds (rank < 2) nearer than this × the mean nearest-neighbour distance to a seed on a
-  /// feature (rank ≥ 2) are dropped (--feature-clearance; 0: none). Not in the paper.
+  /// Seeds crowding a feature seed are dropped (SeedsBesideFeatures with limit this × the mean nearest-
+  /// neighbour distance): feature seeds are thinned to this spacing, sheet seeds kept this far from them
+  /// (--feature-clearance; 0: none). Not in the paper.
   double feature_clearance = 0.4;
+  /// L1 steps of the feature seeds (rank ≥ 2) alone after the outer loop, each after fresh cells and ranks
+  /// (--feature-steps). Not in the paper's Alg. 1, see docs/optimize-seeds.md.
+  int feature_steps = 3;
   double max_step = 0.5;          ///< trust region: a repulsion round moves a seed at most this many σ (--max-step)
   double repulsion_cutoff = 3.0;  ///< neighbours interact within this many σ (kernel 1.1e-2 at 3σ) (--repulsion-cutoff)
   double l1_tol_rel = 1e-6;       ///< L1 step solved to this position accuracy, relative to the diagonal (--l1-tol-rel)
@@ -52,11 +56,26 @@ struct OuterIterationReport {
   double seconds = 0.0;
 };
 
-/// Drops every sheet seed (rank < 2) nearer than `limit` to a seed on a feature (rank ≥ 2); the others keep
-/// their order. Why (not in the paper): such a seed's geodesic region reaches the feature curve between the
-/// curve's seeds, and the dual then gets faces from it across the curve to the other sheets, i.e. folds
-/// beside a branching curve (docs/optimize-seeds.md, "Feature clearance"). Logs the count dropped.
-SeedCloud DropSeedsBesideFeatures(const SeedCloud& in, double limit, Monitor& monitor);
+/// Marks the seeds that crowd a feature seed: feature seeds (rank ≥ 2) are thinned greedily, corners (rank 3)
+/// before curves (rank 2), so that no two lie nearer than `limit`; then every sheet seed (rank < 2) nearer
+/// than `limit` to a kept feature seed is marked. Within a rank, seeds with a lower misfit are kept first.
+/// Why (not in the paper): optimize-seeds gathers every seed whose cell sees two sheets onto the curve, so
+/// the curve seeds end up 2–5 times denser than the sheets and unevenly spaced (crossing-planes, 1k seeds:
+/// gaps 0.2–1.1 sheet spacings); their thin geodesic regions are narrower than build-gvd's neighbourhoods
+/// resolve, and the dual folds beside the curve. A sheet seed beside a curve has a region that reaches the
+/// curve between the curve's seeds, with the same result; two seeds at one corner give a sliver and hold
+/// each other off the corner (docs/optimize-seeds.md, "Feature clearance").
+/// \param position  seed positions
+/// \param rank      per seed, 0–3 (values above 3 count as 3)
+/// \param limit     clearance distance (world units)
+/// \param misfit    optional, per seed: lower is preferred among equal ranks; empty: input order
+/// \param tangent   optional, per seed: the unit curve direction of a curve seed, zero for others. Given, a
+///                  sheet seed is also marked when it lies within `limit` of the segment between two kept
+///                  feature seeds (within 3 × `limit` of it) that runs along their tangents (|cos| ≥ 0.9):
+///                  between two curve seeds, it is as near the curve as beside one.
+/// \return          per seed, 1 if it should be dropped
+std::vector<char> SeedsBesideFeatures(const std::vector<Vec3>& position, const std::vector<uint8_t>& rank, double limit,
+                                      const std::vector<double>& misfit = {}, const std::vector<Vec3>& tangent = {});
 
 /// Paper Alg. 1 lines 2–16 (Sec. 3.1 Eqs. energy_l1 / energy_l1_regularizer, Sec. 3.2 Eqs. particle /
 /// particle_proj). Input seeds are first projected onto the zero set (seeds that do not converge and exact
@@ -69,16 +88,17 @@ SeedCloud DropSeedsBesideFeatures(const SeedCloud& in, double limit, Monitor& mo
 /// projection — until the projected gradient's norm changes by less than δ relatively, or
 /// max_inner_iters. A move whose projection fails, or that lands a seed nearer to another than
 /// min(floor, its previous nearest distance), is undone. The outer loop ends when an inner loop moves no
-/// seed farther than move_tol·σ, or after max_outer_iters. A last L1 step puts seeds that slid along a
-/// curved feature back onto it; ranks are recomputed at the final positions.
+/// seed farther than move_tol·σ, or after max_outer_iters. Then feature_steps L1 steps of the feature seeds
+/// alone put seeds that slid along a curved feature back onto it; before each move, seeds whose targets
+/// crowd a feature seed's are dropped (SeedsBesideFeatures, by the misfit at the target). At the end the
+/// ranks are recomputed at the final positions and crowding seeds dropped again.
 /// \param udf           the field (thread-safe batched queries); lengths are relative to its domain diagonal
 /// \param input         seeds (only positions are used); at least 2 distinct ones
 /// \param options       see OptimizeSeedsOptions; checked first (UsageError)
 /// \param monitor       logs one line per outer iteration and a progress task per outer iteration
 /// \param on_iteration  optional: sees the seeds after every outer iteration (for --trace)
-/// Finally, sheet seeds within feature_clearance × the mean spacing of a feature seed are dropped.
 /// \return seeds on the zero set (d < proj_tol_rel·diagonal) with UDF value, gradient and rank, in input
-///         order. Deterministic for given inputs and options, also across thread counts (fixed-order
+///         order (fewer than the input when seeds were dropped). Deterministic for given inputs and options, also across thread counts (fixed-order
 ///         reductions, per-seed random streams). Throws InputError for fewer than 2 distinct seeds,
 ///         NumericalError if fewer than 2 seeds reach the surface.
 SeedCloud OptimizeSeeds(const Udf& udf, const SeedCloud& input, const OptimizeSeedsOptions& options, Monitor& monitor,
