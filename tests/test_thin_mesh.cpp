@@ -245,6 +245,19 @@ TEST(ThinMesh, ATriangularHoleIsClosedButNotTheOutline) {
   EXPECT_EQ(ThinMesh(*udf, tri, MinFaces(1), Monitor::Null()).faces.size(), 1u);
 }
 
+// A vertical fin standing on row 3 (the line y = 0) of AddGrid(m, 6, 6): vertices above (i, 3) at z = 0.1,
+// two faces per cell i except the cells in `skip`. Returns the index of its first vertex.
+int AddFinOnRow3(TriangleMesh& m, const std::set<int>& skip = {}) {
+  const int base = static_cast<int>(m.vertices.size());
+  for (int i = 0; i <= 6; ++i) m.vertices.push_back({-0.3 + 0.1 * i, 0.0, 0.1});
+  for (int i = 0; i < 6; ++i) {
+    if (skip.count(i)) continue;
+    m.faces.push_back({21 + i, 22 + i, base + i + 1});
+    m.faces.push_back({21 + i, base + i + 1, base + i});
+  }
+  return base;
+}
+
 TEST(ThinMesh, ANotchAtABranchingLineIsClosed) {
   const auto udf = MakeShape("disc");
   TriangleMesh m;
@@ -252,18 +265,35 @@ TEST(ThinMesh, ANotchAtABranchingLineIsClosed) {
   // A vertical fin standing on row 3 makes its edges branching (3 faces). The grid face (2,2)-(3,3)-(2,3)
   // is missing: vertex (2,2) has boundary edges to (3,3) and (2,3), whose edge keeps the fin's face and the
   // grid face above it. Step 5 puts the face back; the fin is untouched.
-  const int base = static_cast<int>(m.vertices.size());
-  for (int i = 0; i <= 6; ++i) m.vertices.push_back({-0.3 + 0.1 * i, 0.0, 0.1});
-  for (int i = 0; i < 6; ++i) {
-    m.faces.push_back({21 + i, 22 + i, base + i + 1});
-    m.faces.push_back({21 + i, base + i + 1, base + i});
-  }
+  AddFinOnRow3(m);
   const int v22 = 16, v33 = 24, v23 = 23;
   m.faces.erase(std::find(m.faces.begin(), m.faces.end(), Tri{v22, v33, v23}));
   ThinMeshStats stats;
   const TriangleMesh out = ThinMesh(*udf, m, ThinMeshOptions{}, Monitor::Null(), &stats);
   EXPECT_EQ(stats.holes_closed, 1u);
   EXPECT_TRUE(SortedFaces(out).count({v22, v23, v33}));
+  const TopologyStats topo = ComputeTopology(out);
+  EXPECT_EQ(topo.boundary_edges, 24u + 8u);  // the grid's outline and the fin's three free sides
+  EXPECT_EQ(topo.nonmanifold_edges, 6u);     // row 3
+  EXPECT_EQ(out.faces.size(), 72u + 12u);
+}
+
+TEST(ThinMesh, AFaceOverACrackAtABranchingLineIsSplit) {
+  const auto udf = MakeShape("disc");
+  TriangleMesh m;
+  AddGrid(m, 6, 6);  // vertex (i, j) is j * 7 + i; row j = 3 is the line y = 0
+  // A vertical fin stands on row 3, but one of its faces spans (1,3)-(3,3) over the grid vertex (2,3): a
+  // T-junction, with a boundary edge (1,3)-(3,3) and no fin face on (1,3)-(2,3), (2,3)-(3,3). Step 5 splits
+  // that face at (2,3), so every edge of row 3 has its three faces and the crack is gone.
+  const int base = AddFinOnRow3(m, {1, 2});
+  const int v13 = 22, v23 = 23, v33 = 24;
+  for (const Tri& t : std::vector<Tri>{{v13, base + 2, base + 1}, {v13, v33, base + 2}, {v33, base + 3, base + 2}})
+    m.faces.push_back(t);
+  ThinMeshStats stats;
+  const TriangleMesh out = ThinMesh(*udf, m, ThinMeshOptions{}, Monitor::Null(), &stats);
+  EXPECT_EQ(stats.cracks_split, 1u);
+  EXPECT_TRUE(SortedFaces(out).count({v13, v23, base + 2}));
+  EXPECT_TRUE(SortedFaces(out).count({v23, v33, base + 2}));
   const TopologyStats topo = ComputeTopology(out);
   EXPECT_EQ(topo.boundary_edges, 24u + 8u);  // the grid's outline and the fin's three free sides
   EXPECT_EQ(topo.nonmanifold_edges, 6u);     // row 3

@@ -440,6 +440,15 @@ std::vector<Tri> GreedyTriangulation(const std::vector<Vec3>& vertices, const st
   return out;
 }
 
+/// Drops the faces marked in `gone` (order kept) and appends `added`.
+void ReplaceFaces(std::vector<Tri>& faces, const std::vector<char>& gone, const std::vector<Tri>& added) {
+  std::vector<Tri> next;
+  for (size_t f = 0; f < faces.size(); ++f)
+    if (!gone[f]) next.push_back(faces[f]);
+  next.insert(next.end(), added.begin(), added.end());
+  faces.swap(next);
+}
+
 /// Step 4: re-triangulates flat folds. For each non-manifold edge (a, b), in edge order, the patch of faces
 /// touching a or b is replaced by the 2-D Delaunay triangulation of its vertices projected on the patch's
 /// best-fit plane, keeping the triangles inside the projected patch, when every patch face is within
@@ -675,11 +684,7 @@ size_t RetriangulateFlatFolds(const std::vector<Vec3>& vertices, std::vector<Tri
     }
     if (this_round == 0) break;
     replaced += this_round;
-    std::vector<Tri> next;
-    for (size_t f = 0; f < faces.size(); ++f)
-      if (!gone[f]) next.push_back(faces[f]);
-    next.insert(next.end(), added.begin(), added.end());
-    faces.swap(next);
+    ReplaceFaces(faces, gone, added);
   }
   return replaced;
 }
@@ -732,6 +737,76 @@ size_t CloseTriangularHoles(const std::vector<Vec3>& vertices, std::vector<Tri>&
       }
   }
   return added;
+}
+
+/// Step 5, cracks: a boundary edge (a, b) whose one face is (a, b, s), with a vertex m that is joined to a
+/// and to b by edges and lies on the segment a-b (the triangle (a, m, b) a sliver, quality below
+/// `max_sliver_quality`), is a T-junction: one sheet's face spans the edge that the other sheets split at
+/// m (on sphere-disc, a curve seed whose region the disc's dense samples missed). The face is split into
+/// (a, m, s) and (m, b, s), unless either is degenerate, exists, or would lie over a face of its edge on
+/// m (third vertices within acos(min_cos) of each other seen from the edge). Returns the faces split.
+size_t SplitFacesOverCracks(const std::vector<Vec3>& vertices, std::vector<Tri>& faces, double min_quality,
+                            double min_cos, double max_sliver_quality) {
+  using Edge = std::pair<int, int>;
+  auto key = [](int u, int v) { return Edge(std::min(u, v), std::max(u, v)); };
+  auto at = [&](int v) -> const Vec3& { return vertices[static_cast<size_t>(v)]; };
+  size_t split = 0;
+  for (int round = 0; round < 4; ++round) {
+    std::map<Edge, std::vector<int>> third;  // edge -> the third vertices of its faces
+    std::map<Edge, size_t> face_of;          // boundary edge -> its face
+    std::map<int, std::set<int>> joined;     // vertex -> its neighbours along edges
+    for (size_t f = 0; f < faces.size(); ++f) {
+      const Tri& t = faces[f];
+      for (int k = 0; k < 3; ++k) {
+        const int u = t[static_cast<size_t>(k)], v = t[static_cast<size_t>((k + 1) % 3)];
+        third[key(u, v)].push_back(t[static_cast<size_t>((k + 2) % 3)]);
+        face_of[key(u, v)] = f;
+        joined[u].insert(v);
+        joined[v].insert(u);
+      }
+    }
+    auto over = [&](int u, int v, int w) {
+      const auto it = third.find(key(u, v));
+      if (it == third.end()) return false;
+      for (int z : it->second)
+        if (SameSideOfEdge(vertices, u, v, w, z, min_cos)) return true;
+      return false;
+    };
+    std::set<Tri> existing;
+    for (const Tri& t : faces) existing.insert(Sorted(t));
+    std::vector<char> used(faces.size(), 0);
+    std::vector<Tri> added;
+    for (const auto& [e, w] : third) {
+      if (w.size() != 1) continue;
+      const auto [a, b] = e;
+      const int s = w[0];
+      const size_t f = face_of[e];
+      if (used[f]) continue;
+      int best = -1;
+      double best_quality = max_sliver_quality;
+      for (int m : joined[a]) {
+        if (m == b || m == s || !joined[b].count(m)) continue;
+        const double t = (at(m) - at(a)).dot(at(b) - at(a)) / (at(b) - at(a)).squaredNorm();
+        const double q = TriangleQuality(at(a), at(m), at(b));
+        if (t > 0.0 && t < 1.0 && q < best_quality) best = m, best_quality = q;
+      }
+      if (best < 0) continue;
+      const Tri h1 = Sorted({a, best, s}), h2 = Sorted({best, b, s});
+      if (IsDegenerate(TriangleQuality(at(a), at(best), at(s)), min_quality) ||
+          IsDegenerate(TriangleQuality(at(best), at(b), at(s)), min_quality) || existing.count(h1) || existing.count(h2) ||
+          over(a, best, s) || over(best, b, s))
+        continue;
+      used[f] = 1;
+      added.push_back(h1);
+      added.push_back(h2);
+      existing.insert(h1);
+      existing.insert(h2);
+      ++split;
+    }
+    if (added.empty()) break;
+    ReplaceFaces(faces, used, added);
+  }
+  return split;
 }
 
 std::string Count(size_t n, const char* what) { return std::to_string(n) + " " + what; }
@@ -887,8 +962,12 @@ TriangleMesh ThinMesh(const Udf& udf, const TriangleMesh& thick, const ThinMeshO
                                                       options.degenerate_quality, false);
     monitor.Info(Count(st.folds_retriangulated, "flat folds re-triangulated"));
   }
-  // 5. Triangular holes: three boundary edges that form a cycle are a junction whose face the thinning (or
-  // the dual) lost; a true boundary loop of three edges does not occur in a mesh of this resolution.
+  // 5. Cracks (T-junctions), then triangular holes: three boundary edges that form a cycle are a junction
+  // whose face the thinning (or the dual) lost; a true boundary loop of three edges does not occur in a mesh
+  // of this resolution.
+  st.cracks_split = SplitFacesOverCracks(thick.vertices, kept, options.degenerate_quality,
+                                         std::cos(options.fold_flatness_deg * M_PI / 180.0), 0.1);
+  if (st.cracks_split > 0) monitor.Info(Count(st.cracks_split, "faces split over a crack (T-junction)"));
   st.holes_closed = CloseTriangularHoles(thick.vertices, kept, options.degenerate_quality,
                                          std::cos(options.fold_flatness_deg * M_PI / 180.0));
   if (st.holes_closed > 0) monitor.Info(Count(st.holes_closed, "triangular holes closed"));

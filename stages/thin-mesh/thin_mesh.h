@@ -40,6 +40,7 @@ struct ThinMeshStats {
   size_t component_faces_removed = 0;
   size_t small_components_left = 0; ///< small components whose removal would have opened a hole
   size_t folds_retriangulated = 0;   ///< step 4: patches around flat non-manifold edges replaced
+  size_t cracks_split = 0;           ///< step 5: faces split over a vertex on their boundary edge (T-junctions)
   size_t holes_closed = 0;           ///< step 5: triangular holes and notches given their face
   size_t rim_folds_opened = 0;       ///< step 6: patches around folds at open rims replaced
   int rounds = 0;                   ///< rounds of (tetrahedra, components) until nothing changed
@@ -71,7 +72,10 @@ struct ThinMeshStats {
 ///     plane, the edges shared with faces outside the patch stay, and the result has fewer non-manifold +
 ///     folded edges, no more non-manifold and no more boundary edges. Branching edges (sheets meeting at an
 ///     angle) are not flat and stay.
-///  5. Where a vertex b has boundary edges to a and c and a-c is an edge (a triangular hole, or a notch at a
+///  5. A boundary edge (a, b) with one face (a, b, s) and a vertex m joined to a and b that lies on the
+///     segment a-b (quality of (a, m, b) below 0.1): the face is split into (a, m, s) and (m, b, s) unless
+///     either is degenerate, exists, or lies over a face of its edge on m (a T-junction: the other sheets
+///     split a-b at m). Then, where a vertex b has boundary edges to a and c and a-c is an edge (a triangular hole, or a notch at a
 ///     branching curve), the face (a, b, c) is added unless it is degenerate or lies over a face of one of
 ///     its edges (a junction lost by the dual or by steps 1–4).
 ///  6. Step 4 again, where a folded edge between two boundary vertices may become a boundary edge (a fold at
