@@ -140,6 +140,26 @@ TEST(BuildGvd, OverPrunedGraphsLeaveUnreachedSamplesCounted) {
   EXPECT_GT(r.stats.edges_pruned_udf, 0u);
 }
 
+// build-gvd queries a midpoint only when the Lipschitz bound min(d(a), d(b)) + |ab|/2 exceeds eps_udf; the
+// kept graph must still be exactly the edges whose midpoint is within eps_udf (checked here by querying all).
+TEST(BuildGvd, KeptEdgesHaveTheirMidpointWithinEpsUdf) {
+  const auto udf = MakeShape("sphere");
+  const SeedCloud seeds = Seeds(*udf, 100);
+  BuildGvdOptions o;
+  o.eps_udf_rel = 2e-4;  // between the shortest and the longest edges' sagitta bounds: some edges go
+  const GvdResult r = BuildGvd(*udf, seeds, o, true, Monitor::Null());
+  ASSERT_FALSE(r.samples.edges.empty());
+  EXPECT_GT(r.stats.edges_pruned_udf, 0u);
+  const double eps = o.eps_udf_rel * udf->Domain().Diagonal();
+  size_t long_kept = 0;
+  for (const auto& e : r.samples.edges) {
+    const Vec3 a = r.samples.position[static_cast<size_t>(e[0])], b = r.samples.position[static_cast<size_t>(e[1])];
+    EXPECT_LE(udf->Distance(0.5 * (a + b)), eps);
+    long_kept += 0.5 * (b - a).norm() > eps;  // edges the bound alone could not accept
+  }
+  EXPECT_GT(long_kept, 0u);
+}
+
 TEST(BuildGvd, SameResultWhateverTheThreadCount) {
   const auto udf = MakeShape("three-discs");
   const SeedCloud seeds = Seeds(*udf, 300);
