@@ -85,6 +85,26 @@ void EraseSeeds(State& s, const std::vector<char>& drop) {
   s.space.resize(k);
 }
 
+// Feature-seed thinning (SeedsBesideFeatures) judged at `where` (the seeds' positions or their step
+// targets), at the state's ranks; the marked seeds leave the state and, if given, `carried` (a per-seed
+// array alongside it). Returns the count dropped.
+size_t ThinCrowded(State& s, const std::vector<Vec3>& where, const std::vector<double>& misfit, double limit,
+                   std::vector<Vec3>* carried = nullptr) {
+  std::vector<uint8_t> ranks(s.rank.size());
+  for (size_t i = 0; i < ranks.size(); ++i) ranks[i] = static_cast<uint8_t>(s.rank[i].rank);
+  const std::vector<char> drop = SeedsBesideFeatures(where, ranks, limit, misfit, Tangents(s));
+  const size_t dropped = static_cast<size_t>(std::count(drop.begin(), drop.end(), 1));
+  if (dropped == 0) return 0;
+  EraseSeeds(s, drop);
+  if (carried) {
+    size_t k = 0;
+    for (size_t i = 0; i < drop.size(); ++i)
+      if (!drop[i]) (*carried)[k++] = (*carried)[i];
+    carried->resize(k);
+  }
+  return dropped;
+}
+
 class Optimizer {
  public:
   Optimizer(const Udf& udf, const OptimizeSeedsOptions& options, Monitor& monitor)
@@ -302,15 +322,13 @@ class Optimizer {
     return minimum;
   }
 
-  // Drops the seeds SeedsBesideFeatures marks at the current ranks (feature_clearance × the mean spacing).
-  // A seed's misfit, which decides between two crowded corner seeds, is the mean distance of its position
-  // from the tangent planes of its cell's samples: zero on the corner itself. Returns the count dropped.
+  // Thins the seeds at their current positions and ranks (feature_clearance × the mean spacing). A seed's
+  // misfit, which decides between two crowded feature seeds, is the mean distance of its position from the
+  // tangent planes of its cell's samples: zero on the corner itself. Returns the count dropped.
   size_t DropCrowded(State& s, const CellSamples& cells) const {
     const size_t n = s.position.size();
-    std::vector<uint8_t> ranks(n);
     std::vector<double> misfit(n, INFINITY);
     for (size_t i = 0; i < n; ++i) {
-      ranks[i] = static_cast<uint8_t>(s.rank[i].rank);
       double sum = 0.0;
       size_t count = 0;
       for (size_t m = cells.sample_offset[i]; m < cells.sample_offset[i + 1]; ++m) {
@@ -321,11 +339,8 @@ class Optimizer {
       }
       if (count > 0) misfit[i] = sum / static_cast<double>(count);
     }
-    const std::vector<char> drop =
-        SeedsBesideFeatures(s.position, ranks, options_.feature_clearance * MeanSpacing(s.position), misfit, Tangents(s));
-    const size_t dropped = static_cast<size_t>(std::count(drop.begin(), drop.end(), 1));
-    if (dropped > 0) EraseSeeds(s, drop);
-    return dropped;
+    const std::vector<Vec3> where = s.position;
+    return ThinCrowded(s, where, misfit, options_.feature_clearance * MeanSpacing(s.position));
   }
 
   // Mean and coefficient of variation of the nearest-neighbour distances (the spacing's evenness).
@@ -631,19 +646,8 @@ SeedCloud OptimizeSeeds(const Udf& udf, const SeedCloud& input, const OptimizeSe
     // Seeds whose steps meet are thinned before the move (the better fitting target stays): otherwise two
     // corner seeds both step onto one corner, Project undoes both moves as too near, and neither reaches it.
     if (options.feature_clearance > 0.0) {
-      std::vector<uint8_t> ranks(s.rank.size());
-      for (size_t i = 0; i < ranks.size(); ++i) ranks[i] = static_cast<uint8_t>(s.rank[i].rank);
-      const std::vector<char> drop = SeedsBesideFeatures(targets, ranks, options.feature_clearance * opt.MeanSpacing(s.position),
-                                                         misfit, Tangents(s));
-      const size_t dropped = static_cast<size_t>(std::count(drop.begin(), drop.end(), 1));
-      if (dropped > 0) {
-        EraseSeeds(s, drop);
-        size_t k = 0;
-        for (size_t i = 0; i < drop.size(); ++i)
-          if (!drop[i]) targets[k++] = targets[i];
-        targets.resize(k);
-        crowded += dropped;
-      }
+      const std::vector<Vec3> where = targets;
+      crowded += ThinCrowded(s, where, misfit, options.feature_clearance * opt.MeanSpacing(s.position), &targets);
     }
     const std::vector<Vec3> before = s.position;
     opt.Project(s, before, std::move(targets), 0.25 * opt.MeanSpacing(s.position));
@@ -653,8 +657,8 @@ SeedCloud OptimizeSeeds(const Udf& udf, const SeedCloud& input, const OptimizeSe
   const CellSamples final_cells = opt.Analyze(s);
   if (options.feature_clearance > 0.0) crowded += opt.DropCrowded(s, final_cells);
   if (crowded > 0)
-    monitor.Info(std::to_string(crowded) + Format(" seeds dropped: nearer than %.2f x the mean spacing to a seed on a "
-                                                  "higher-ranked feature", options.feature_clearance));
+    monitor.Info(std::to_string(crowded) + Format(" seeds dropped by the feature-seed thinning (nearer than %.2f x the "
+                                                  "mean spacing to a kept curve or corner seed)", options.feature_clearance));
   OuterIterationReport final_report;
   CountRanks(s, final_report);
   monitor.Info(Format("done in %.2f s; mean |udf| %.3g (rel); spacing CV %.3f -> %.3f; ",
