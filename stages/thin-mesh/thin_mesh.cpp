@@ -689,6 +689,49 @@ size_t RetriangulateFlatFolds(const std::vector<Vec3>& vertices, std::vector<Tri
   return replaced;
 }
 
+/// The faces around each edge of a face list, for the hole-closing steps: each edge's third vertices, and
+/// each vertex's neighbours along boundary edges (edges with one face).
+struct EdgeFans {
+  std::map<std::pair<int, int>, std::vector<int>> third;
+  std::map<int, std::vector<int>> open;  // sorted
+
+  explicit EdgeFans(const std::vector<Tri>& faces) {
+    for (const Tri& t : faces)
+      for (int k = 0; k < 3; ++k) {
+        const int u = t[static_cast<size_t>(k)], v = t[static_cast<size_t>((k + 1) % 3)];
+        third[Key(u, v)].push_back(t[static_cast<size_t>((k + 2) % 3)]);
+      }
+    for (const auto& [e, w] : third)
+      if (w.size() == 1) {
+        open[e.first].push_back(e.second);
+        open[e.second].push_back(e.first);
+      }
+    for (auto& [v, nb] : open) std::sort(nb.begin(), nb.end());
+  }
+  static std::pair<int, int> Key(int u, int v) { return {std::min(u, v), std::max(u, v)}; }
+  bool HasEdge(int u, int v) const { return third.count(Key(u, v)) > 0; }
+  bool HasFace(int u, int v, int w) const {
+    const auto it = third.find(Key(u, v));
+    return it != third.end() && std::find(it->second.begin(), it->second.end(), w) != it->second.end();
+  }
+  /// Whether a face (u, v, w) would lie over a face of edge u-v: third vertices within acos(min_cos) of
+  /// each other seen from the edge.
+  bool Over(const std::vector<Vec3>& vertices, int u, int v, int w, double min_cos) const {
+    const auto it = third.find(Key(u, v));
+    if (it == third.end()) return false;
+    for (int z : it->second)
+      if (SameSideOfEdge(vertices, u, v, w, z, min_cos)) return true;
+    return false;
+  }
+  /// A new face (u, v, w): not degenerate, not there already, over no face of its three edges.
+  bool Fits(const std::vector<Vec3>& vertices, int u, int v, int w, double min_quality, double min_cos) const {
+    const double q = TriangleQuality(vertices[static_cast<size_t>(u)], vertices[static_cast<size_t>(v)],
+                                     vertices[static_cast<size_t>(w)]);
+    return !IsDegenerate(q, min_quality) && !HasFace(u, v, w) && !Over(vertices, u, v, w, min_cos) &&
+           !Over(vertices, v, w, u, min_cos) && !Over(vertices, w, u, v, min_cos);
+  }
+};
+
 /// Step 5: adds the face (a, b, c) wherever b has boundary edges (edges with one face) to a and to c and the
 /// third side a-c is an edge too, either a boundary edge (a triangular hole) or one with faces (a notch
 /// next to a branching curve or a sheet), unless the triangle is degenerate or would lie over a face of
@@ -696,46 +739,19 @@ size_t RetriangulateFlatFolds(const std::vector<Vec3>& vertices, std::vector<Tri
 /// that is the face already there). Returns the number added.
 size_t CloseTriangularHoles(const std::vector<Vec3>& vertices, std::vector<Tri>& faces, double min_quality,
                             double min_cos) {
-  std::map<std::pair<int, int>, std::vector<int>> third;  // edge -> the third vertices of its faces
-  for (const Tri& t : faces)
-    for (int k = 0; k < 3; ++k) {
-      const int u = t[static_cast<size_t>(k)], v = t[static_cast<size_t>((k + 1) % 3)];
-      third[{std::min(u, v), std::max(u, v)}].push_back(t[static_cast<size_t>((k + 2) % 3)]);
-    }
-  std::map<int, std::vector<int>> open;  // vertex -> its neighbours along boundary edges
-  for (const auto& [e, w] : third)
-    if (w.size() == 1) {
-      open[e.first].push_back(e.second);
-      open[e.second].push_back(e.first);
-    }
-  auto at = [&](int v) -> const Vec3& { return vertices[static_cast<size_t>(v)]; };
-  // Whether a face (u, v, w) would lie over a face of edge u-v.
-  auto over = [&](int u, int v, int w) {
-    const auto it = third.find({std::min(u, v), std::max(u, v)});
-    if (it == third.end()) return false;
-    for (int z : it->second)
-      if (SameSideOfEdge(vertices, u, v, w, z, min_cos)) return true;
-    return false;
-  };
+  const EdgeFans fans(faces);
   size_t added = 0;
   std::set<Tri> done;
-  for (auto& [b, nb] : open) {
-    std::sort(nb.begin(), nb.end());
+  for (const auto& [b, nb] : fans.open)
     for (size_t i = 0; i < nb.size(); ++i)
       for (size_t j = i + 1; j < nb.size(); ++j) {
         const int a = nb[i], c = nb[j];
-        if (!third.count({std::min(a, c), std::max(a, c)})) continue;
+        if (!fans.HasEdge(a, c)) continue;
         const Tri t = Sorted({a, b, c});
-        if (!done.insert(t).second) continue;
-        bool exists = false;
-        for (int w : third[{std::min(a, c), std::max(a, c)}]) exists = exists || w == b;
-        if (exists) continue;
-        const double q = TriangleQuality(at(a), at(b), at(c));
-        if (IsDegenerate(q, min_quality) || over(a, b, c) || over(b, c, a) || over(a, c, b)) continue;
+        if (!done.insert(t).second || !fans.Fits(vertices, a, b, c, min_quality, min_cos)) continue;
         faces.push_back(t);
         ++added;
       }
-  }
   return added;
 }
 
@@ -752,31 +768,23 @@ size_t SplitFacesOverCracks(const std::vector<Vec3>& vertices, std::vector<Tri>&
   auto at = [&](int v) -> const Vec3& { return vertices[static_cast<size_t>(v)]; };
   size_t split = 0;
   for (int round = 0; round < 4; ++round) {
-    std::map<Edge, std::vector<int>> third;  // edge -> the third vertices of its faces
-    std::map<Edge, size_t> face_of;          // boundary edge -> its face
-    std::map<int, std::set<int>> joined;     // vertex -> its neighbours along edges
+    const EdgeFans fans(faces);
+    std::map<Edge, size_t> face_of;       // edge -> (the last of) its faces
+    std::map<int, std::set<int>> joined;  // vertex -> its neighbours along edges
     for (size_t f = 0; f < faces.size(); ++f) {
       const Tri& t = faces[f];
       for (int k = 0; k < 3; ++k) {
         const int u = t[static_cast<size_t>(k)], v = t[static_cast<size_t>((k + 1) % 3)];
-        third[key(u, v)].push_back(t[static_cast<size_t>((k + 2) % 3)]);
         face_of[key(u, v)] = f;
         joined[u].insert(v);
         joined[v].insert(u);
       }
     }
-    auto over = [&](int u, int v, int w) {
-      const auto it = third.find(key(u, v));
-      if (it == third.end()) return false;
-      for (int z : it->second)
-        if (SameSideOfEdge(vertices, u, v, w, z, min_cos)) return true;
-      return false;
-    };
     std::set<Tri> existing;
     for (const Tri& t : faces) existing.insert(Sorted(t));
     std::vector<char> used(faces.size(), 0);
     std::vector<Tri> added;
-    for (const auto& [e, w] : third) {
+    for (const auto& [e, w] : fans.third) {
       if (w.size() != 1) continue;
       const auto [a, b] = e;
       const int s = w[0];
@@ -794,7 +802,7 @@ size_t SplitFacesOverCracks(const std::vector<Vec3>& vertices, std::vector<Tri>&
       const Tri h1 = Sorted({a, best, s}), h2 = Sorted({best, b, s});
       if (IsDegenerate(TriangleQuality(at(a), at(best), at(s)), min_quality) ||
           IsDegenerate(TriangleQuality(at(best), at(b), at(s)), min_quality) || existing.count(h1) || existing.count(h2) ||
-          over(a, best, s) || over(best, b, s))
+          fans.Over(vertices, a, best, s, min_cos) || fans.Over(vertices, best, b, s, min_cos))
         continue;
       used[f] = 1;
       added.push_back(h1);
