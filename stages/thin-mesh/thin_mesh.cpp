@@ -449,6 +449,157 @@ void ReplaceFaces(std::vector<Tri>& faces, const std::vector<char>& gone, const 
   faces.swap(next);
 }
 
+using EdgeKey = std::pair<int, int>;
+using EdgeFaceMap = std::map<EdgeKey, std::vector<Tri>>;
+
+EdgeKey KeyOf(int u, int v) { return {std::min(u, v), std::max(u, v)}; }
+
+/// Step 4's fold: two faces of edge e on the same side of it, nearly coplanar (their third vertices'
+/// perpendiculars from the edge within acos(min_cos)).
+bool FoldedEdge(const std::vector<Vec3>& vertices, const EdgeKey& e, const std::vector<Tri>& fs, double min_cos) {
+  auto third = [&](const Tri& f) { return f[0] + f[1] + f[2] - e.first - e.second; };
+  for (size_t i = 0; i < fs.size(); ++i)
+    for (size_t j = i + 1; j < fs.size(); ++j)
+      if (SameSideOfEdge(vertices, e.first, e.second, third(fs[i]), third(fs[j]), min_cos)) return true;
+  return false;
+}
+
+/// A set of vertices whose faces step 4 re-triangulates, with its first bad edge and whether it has a
+/// non-manifold edge.
+struct FoldCandidate {
+  std::vector<int> centre;  // sorted
+  EdgeKey edge;
+  bool is_nm;
+};
+
+/// Step 4's candidates: every bad edge alone (its two vertices), then every cluster of 3+ vertices joined by
+/// bad edges (a fold can be a whole cycle of folded edges) or by boundary edges between their vertices.
+/// \param bad  the non-manifold (true) and folded manifold (false) edges, in edge order
+std::vector<FoldCandidate> FoldCandidates(const std::vector<std::pair<EdgeKey, bool>>& bad, const EdgeFaceMap& edge_faces) {
+  std::vector<FoldCandidate> candidates;
+  for (const auto& [edge, is_nm] : bad) candidates.push_back({{edge.first, edge.second}, edge, is_nm});
+  std::map<int, int> parent;
+  std::function<int(int)> root = [&](int x) { return parent[x] == x ? x : parent[x] = root(parent[x]); };
+  for (const auto& [edge, is_nm] : bad) {
+    parent.emplace(edge.first, edge.first);
+    parent.emplace(edge.second, edge.second);
+  }
+  for (const auto& [edge, is_nm] : bad) {
+    const int ra = root(edge.first), rb = root(edge.second);
+    parent[std::max(ra, rb)] = std::min(ra, rb);
+  }
+  // A hole next to folds (a boundary edge between two of their vertices) is part of the same defect: the
+  // faces missing there are those the folds doubled.
+  for (const auto& [e, fs] : edge_faces) {
+    if (fs.size() != 1 || !parent.count(e.first) || !parent.count(e.second)) continue;
+    const int ra = root(e.first), rb = root(e.second);
+    parent[std::max(ra, rb)] = std::min(ra, rb);
+  }
+  std::map<int, FoldCandidate> clusters;
+  for (const auto& [edge, is_nm] : bad) {
+    auto [it, fresh] = clusters.emplace(root(edge.first), FoldCandidate{{}, edge, false});
+    it->second.is_nm = it->second.is_nm || is_nm;
+    (void)fresh;
+  }
+  for (const auto& [v, r] : parent) clusters[root(v)].centre.push_back(v);
+  for (auto& [r, c] : clusters)
+    if (c.centre.size() >= 3) candidates.push_back(std::move(c));
+  return candidates;
+}
+
+/// The 2-D Delaunay triangles of the patch vertices `pv` (coordinates `q`) whose centroids lie inside the
+/// projected patch, degenerate ones left out. By hand: at most 24 points.
+std::vector<Tri> DelaunayInPatch(const std::vector<Vec3>& vertices, const std::vector<Tri>& faces,
+                                 const std::vector<size_t>& patch, const std::vector<int>& pv,
+                                 std::unordered_map<int, Eigen::Vector2d>& q, double min_quality) {
+  auto inside_patch = [&](const Eigen::Vector2d& c) { return InsidePatch(faces, patch, q, c); };
+  std::vector<Tri> tris;
+  for (size_t i = 0; i < pv.size(); ++i)
+    for (size_t j = i + 1; j < pv.size(); ++j)
+      for (size_t k = j + 1; k < pv.size(); ++k) {
+        const Eigen::Vector2d &A = q[pv[i]], &B = q[pv[j]], &C = q[pv[k]];
+        const double area2 = Cross2(A, B, C);
+        if (std::abs(area2) < 1e-12 * ((B - A).squaredNorm() + (C - A).squaredNorm())) continue;
+        bool empty = true;
+        for (size_t m = 0; m < pv.size() && empty; ++m) {
+          if (m == i || m == j || m == k) continue;
+          const Eigen::Vector2d& D = q[pv[m]];
+          const Eigen::Vector2d a2 = A - D, b2 = B - D, c2 = C - D;
+          const double det = a2.squaredNorm() * (b2.x() * c2.y() - b2.y() * c2.x()) -
+                             b2.squaredNorm() * (a2.x() * c2.y() - a2.y() * c2.x()) +
+                             c2.squaredNorm() * (a2.x() * b2.y() - a2.y() * b2.x());
+          if ((area2 > 0 ? det : -det) > 0) empty = false;
+        }
+        if (!empty || !inside_patch((A + B + C) / 3.0)) continue;
+        const double quality = TriangleQuality(vertices[static_cast<size_t>(pv[i])], vertices[static_cast<size_t>(pv[j])],
+                                               vertices[static_cast<size_t>(pv[k])]);
+        if (!IsDegenerate(quality, min_quality)) tris.push_back({pv[i], pv[j], pv[k]});
+      }
+  return tris;
+}
+
+/// Step 4's acceptance of the triangles `cand` for `patch`: the edges they share with faces outside the patch
+/// stay, no face is duplicated, and non-manifold plus folded edges drop, with no more non-manifold and no
+/// more boundary edges (beyond the rim folds opened, with `open_rim_folds`).
+bool FoldRepairAccepted(const std::vector<Vec3>& vertices, const std::vector<Tri>& faces,
+                        const std::vector<size_t>& patch, const std::vector<Tri>& cand, const EdgeFaceMap& edge_faces,
+                        const std::set<Tri>& existing, const std::vector<char>& on_rim, bool open_rim_folds,
+                        double min_cos) {
+    // The patch's edges before and after; accept when non-manifold plus folded edges drop, with no more
+    // non-manifold and no more boundary edges (beyond the rim folds opened, with `open_rim_folds`).
+    EdgeFaceMap after;
+    for (size_t f : patch)
+      for (int k = 0; k < 3; ++k) {
+        const EdgeKey e = KeyOf(faces[f][static_cast<size_t>(k)], faces[f][static_cast<size_t>((k + 1) % 3)]);
+        after.emplace(e, edge_faces.at(e));
+      }
+    for (const Tri& t : cand)
+      for (int k = 0; k < 3; ++k) {
+        const EdgeKey e = KeyOf(t[static_cast<size_t>(k)], t[static_cast<size_t>((k + 1) % 3)]);
+        const auto it = edge_faces.find(e);
+        after.emplace(e, it == edge_faces.end() ? std::vector<Tri>() : it->second);
+      }
+    int nm_before = 0, nm_after = 0, open_before = 0, open_after = 0, fold_before = 0, fold_after = 0, rim_opened = 0;
+    bool kept_shared = true;
+    for (auto& [e, fs] : after) {
+      const bool was_open = fs.size() == 1, was_folded = fs.size() == 2 && FoldedEdge(vertices, e, fs, min_cos);
+      nm_before += fs.size() >= 3;
+      open_before += was_open;
+      fold_before += was_folded;
+      size_t own = 0;
+      for (size_t f : patch) {
+        const auto it = std::find(fs.begin(), fs.end(), Sorted(faces[f]));
+        if (it != fs.end()) {
+          fs.erase(it);
+          ++own;
+        }
+      }
+      const bool shared = own > 0 && !fs.empty();  // also used by faces outside the patch
+      bool in_new = false;
+      for (const Tri& t : cand)
+        if ((t[0] == e.first || t[1] == e.first || t[2] == e.first) && (t[0] == e.second || t[1] == e.second || t[2] == e.second)) {
+          fs.push_back(t);
+          in_new = true;
+        }
+      // An edge the patch shares with other faces stays: a branching curve is never cut off.
+      kept_shared = kept_shared && (!shared || in_new);
+      nm_after += fs.size() >= 3;
+      open_after += fs.size() == 1;
+      fold_after += fs.size() == 2 && FoldedEdge(vertices, e, fs, min_cos);
+      // A new boundary edge is a hole, unless allowed at an open rim: both faces were on one side of the
+      // edge and both its vertices are on the boundary (the fold's other side is empty).
+      rim_opened += open_rim_folds && fs.size() == 1 && was_folded && on_rim[static_cast<size_t>(e.first)] &&
+                    on_rim[static_cast<size_t>(e.second)];
+    }
+    bool duplicate = false;
+    for (const Tri& t : cand) {
+      bool own = false;
+      for (size_t f : patch) own = own || Sorted(faces[f]) == t;
+      duplicate = duplicate || (!own && existing.count(t) > 0);
+    }
+    return kept_shared && !(duplicate || nm_after > nm_before || open_after > open_before + rim_opened || nm_after + fold_after >= nm_before + fold_before);
+}
+
 /// Step 4: re-triangulates flat folds. For each non-manifold edge (a, b), in edge order, the patch of faces
 /// touching a or b is replaced by the 2-D Delaunay triangulation of its vertices projected on the patch's
 /// best-fit plane, keeping the triangles inside the projected patch, when every patch face is within
@@ -458,32 +609,21 @@ void ReplaceFaces(std::vector<Tri>& faces, const std::vector<char>& gone, const 
 /// other side is empty). Returns the patches replaced.
 size_t RetriangulateFlatFolds(const std::vector<Vec3>& vertices, std::vector<Tri>& faces, double min_cos,
                               double min_quality, bool open_rim_folds) {
-  using Edge = std::pair<int, int>;
-  auto key = [](int u, int v) { return std::make_pair(std::min(u, v), std::max(u, v)); };
   auto normal = [&](const Tri& t) {
     const Vec3& p0 = vertices[static_cast<size_t>(t[0])];
     return Vec3((vertices[static_cast<size_t>(t[1])] - p0).cross(vertices[static_cast<size_t>(t[2])] - p0));
   };
-  // Two faces of edge e on the same side of it, nearly coplanar: their third vertices' perpendiculars from
-  // the edge within acos(min_cos).
-  auto folded = [&](const Edge& e, const std::vector<Tri>& fs) {
-    auto third = [&](const Tri& f) { return f[0] + f[1] + f[2] - e.first - e.second; };
-    for (size_t i = 0; i < fs.size(); ++i)
-      for (size_t j = i + 1; j < fs.size(); ++j)
-        if (SameSideOfEdge(vertices, e.first, e.second, third(fs[i]), third(fs[j]), min_cos)) return true;
-    return false;
-  };
   size_t replaced = 0;
   for (int round = 0; round < 8; ++round) {
-    std::map<Edge, std::vector<Tri>> edge_faces;
+    EdgeFaceMap edge_faces;
     for (const Tri& t : faces)
-      for (int k = 0; k < 3; ++k) edge_faces[key(t[static_cast<size_t>(k)], t[static_cast<size_t>((k + 1) % 3)])].push_back(Sorted(t));
+      for (int k = 0; k < 3; ++k) edge_faces[KeyOf(t[static_cast<size_t>(k)], t[static_cast<size_t>((k + 1) % 3)])].push_back(Sorted(t));
     std::vector<char> on_rim(vertices.size(), 0);  // vertices with a boundary edge
     for (const auto& [e, fs] : edge_faces)
       if (fs.size() == 1) on_rim[static_cast<size_t>(e.first)] = on_rim[static_cast<size_t>(e.second)] = 1;
-    std::vector<std::pair<Edge, bool>> bad;  // non-manifold edges (true) and folded manifold edges (false)
+    std::vector<std::pair<EdgeKey, bool>> bad;  // non-manifold edges (true) and folded manifold edges (false)
     for (const auto& [e, fs] : edge_faces)
-      if (fs.size() >= 3 || (fs.size() == 2 && folded(e, fs))) bad.push_back({e, fs.size() >= 3});
+      if (fs.size() >= 3 || (fs.size() == 2 && FoldedEdge(vertices, e, fs, min_cos))) bad.push_back({e, fs.size() >= 3});
     if (bad.empty()) break;
     std::vector<char> touched(vertices.size(), 0);
     std::vector<char> gone(faces.size(), 0);
@@ -491,45 +631,8 @@ size_t RetriangulateFlatFolds(const std::vector<Vec3>& vertices, std::vector<Tri
     std::set<Tri> existing;
     for (const Tri& t : faces) existing.insert(Sorted(t));
     size_t this_round = 0;
-    // Candidates: every bad edge alone (its two vertices), then every cluster of 3+ vertices joined by bad
-    // edges (a fold can be a whole cycle of folded edges), each with its first edge and whether it has a
-    // non-manifold edge.
-    struct Candidate {
-      std::vector<int> centre;
-      Edge edge;
-      bool is_nm;
-    };
-    std::vector<Candidate> candidates;
-    for (const auto& [edge, is_nm] : bad) candidates.push_back({{edge.first, edge.second}, edge, is_nm});
-    {
-      std::map<int, int> parent;
-      std::function<int(int)> root = [&](int x) { return parent[x] == x ? x : parent[x] = root(parent[x]); };
-      for (const auto& [edge, is_nm] : bad) {
-        parent.emplace(edge.first, edge.first);
-        parent.emplace(edge.second, edge.second);
-      }
-      for (const auto& [edge, is_nm] : bad) {
-        const int ra = root(edge.first), rb = root(edge.second);
-        parent[std::max(ra, rb)] = std::min(ra, rb);
-      }
-      // A hole next to folds (a boundary edge between two of their vertices) is part of the same defect:
-      // the faces missing there are those the folds doubled.
-      for (const auto& [e, fs] : edge_faces) {
-        if (fs.size() != 1 || !parent.count(e.first) || !parent.count(e.second)) continue;
-        const int ra = root(e.first), rb = root(e.second);
-        parent[std::max(ra, rb)] = std::min(ra, rb);
-      }
-      std::map<int, Candidate> clusters;
-      for (const auto& [edge, is_nm] : bad) {
-        auto [it, fresh] = clusters.emplace(root(edge.first), Candidate{{}, edge, false});
-        it->second.is_nm = it->second.is_nm || is_nm;
-        (void)fresh;
-      }
-      for (const auto& [v, r] : parent) clusters[root(v)].centre.push_back(v);
-      for (auto& [r, c] : clusters)
-        if (c.centre.size() >= 3) candidates.push_back(std::move(c));
-    }
-    for (const Candidate& item : candidates) {
+    const std::vector<FoldCandidate> candidates = FoldCandidates(bad, edge_faces);
+    for (const FoldCandidate& item : candidates) {
       const bool is_nm = item.is_nm;
       // The plane of the fold: a face of the first same-side pair on the candidate's edge.
       Vec3 fold_normal = Vec3::Zero();
@@ -537,7 +640,7 @@ size_t RetriangulateFlatFolds(const std::vector<Vec3>& vertices, std::vector<Tri
         const std::vector<Tri>& fs = edge_faces[item.edge];
         for (size_t i = 0; i < fs.size() && fold_normal.isZero(); ++i)
           for (size_t j = i + 1; j < fs.size() && fold_normal.isZero(); ++j)
-            if (folded(item.edge, {fs[i], fs[j]})) fold_normal = normal(fs[i]).normalized();
+            if (FoldedEdge(vertices, item.edge, {fs[i], fs[j]}, min_cos)) fold_normal = normal(fs[i]).normalized();
       }
       std::vector<size_t> patch;
       std::vector<int> pv;
@@ -586,83 +689,9 @@ size_t RetriangulateFlatFolds(const std::vector<Vec3>& vertices, std::vector<Tri
       const Vec3 w = mean.cross(u);
       std::unordered_map<int, Eigen::Vector2d> q;
       for (int v : pv) q[v] = Eigen::Vector2d(vertices[static_cast<size_t>(v)].dot(u), vertices[static_cast<size_t>(v)].dot(w));
-      auto inside_patch = [&](const Eigen::Vector2d& c) { return InsidePatch(faces, patch, q, c); };
-      std::vector<Tri> tris;
-      for (size_t i = 0; i < pv.size(); ++i)
-        for (size_t j = i + 1; j < pv.size(); ++j)
-          for (size_t k = j + 1; k < pv.size(); ++k) {
-            const Eigen::Vector2d &A = q[pv[i]], &B = q[pv[j]], &C = q[pv[k]];
-            const double area2 = Cross2(A, B, C);
-            if (std::abs(area2) < 1e-12 * ((B - A).squaredNorm() + (C - A).squaredNorm())) continue;
-            bool empty = true;
-            for (size_t m = 0; m < pv.size() && empty; ++m) {
-              if (m == i || m == j || m == k) continue;
-              const Eigen::Vector2d& D = q[pv[m]];
-              const Eigen::Vector2d a2 = A - D, b2 = B - D, c2 = C - D;
-              const double det = a2.squaredNorm() * (b2.x() * c2.y() - b2.y() * c2.x()) -
-                                 b2.squaredNorm() * (a2.x() * c2.y() - a2.y() * c2.x()) +
-                                 c2.squaredNorm() * (a2.x() * b2.y() - a2.y() * b2.x());
-              if ((area2 > 0 ? det : -det) > 0) empty = false;
-            }
-            if (!empty || !inside_patch((A + B + C) / 3.0)) continue;
-            const double quality = TriangleQuality(vertices[static_cast<size_t>(pv[i])], vertices[static_cast<size_t>(pv[j])],
-                                                   vertices[static_cast<size_t>(pv[k])]);
-            if (!IsDegenerate(quality, min_quality)) tris.push_back({pv[i], pv[j], pv[k]});
-          }
+      std::vector<Tri> tris = DelaunayInPatch(vertices, faces, patch, pv, q, min_quality);
       auto acceptable = [&](const std::vector<Tri>& cand) {
-        // The patch's edges before and after; accept when non-manifold plus folded edges drop, with no more
-        // non-manifold and no more boundary edges (beyond the rim folds opened, with `open_rim_folds`).
-        std::map<Edge, std::vector<Tri>> after;
-        for (size_t f : patch)
-          for (int k = 0; k < 3; ++k) {
-            const Edge e = key(faces[f][static_cast<size_t>(k)], faces[f][static_cast<size_t>((k + 1) % 3)]);
-            after.emplace(e, edge_faces[e]);
-          }
-        for (const Tri& t : cand)
-          for (int k = 0; k < 3; ++k) {
-            const Edge e = key(t[static_cast<size_t>(k)], t[static_cast<size_t>((k + 1) % 3)]);
-            const auto it = edge_faces.find(e);
-            after.emplace(e, it == edge_faces.end() ? std::vector<Tri>() : it->second);
-          }
-        int nm_before = 0, nm_after = 0, open_before = 0, open_after = 0, fold_before = 0, fold_after = 0, rim_opened = 0;
-        bool kept_shared = true;
-        for (auto& [e, fs] : after) {
-          const bool was_open = fs.size() == 1, was_folded = fs.size() == 2 && folded(e, fs);
-          nm_before += fs.size() >= 3;
-          open_before += was_open;
-          fold_before += was_folded;
-          size_t own = 0;
-          for (size_t f : patch) {
-            const auto it = std::find(fs.begin(), fs.end(), Sorted(faces[f]));
-            if (it != fs.end()) {
-              fs.erase(it);
-              ++own;
-            }
-          }
-          const bool shared = own > 0 && !fs.empty();  // also used by faces outside the patch
-          bool in_new = false;
-          for (const Tri& t : cand)
-            if ((t[0] == e.first || t[1] == e.first || t[2] == e.first) && (t[0] == e.second || t[1] == e.second || t[2] == e.second)) {
-              fs.push_back(t);
-              in_new = true;
-            }
-          // An edge the patch shares with other faces stays: a branching curve is never cut off.
-          kept_shared = kept_shared && (!shared || in_new);
-          nm_after += fs.size() >= 3;
-          open_after += fs.size() == 1;
-          fold_after += fs.size() == 2 && folded(e, fs);
-          // A new boundary edge is a hole, unless allowed at an open rim: both faces were on one side of the
-          // edge and both its vertices are on the boundary (the fold's other side is empty).
-          rim_opened += open_rim_folds && fs.size() == 1 && was_folded && on_rim[static_cast<size_t>(e.first)] &&
-                        on_rim[static_cast<size_t>(e.second)];
-        }
-        bool duplicate = false;
-        for (const Tri& t : cand) {
-          bool own = false;
-          for (size_t f : patch) own = own || Sorted(faces[f]) == t;
-          duplicate = duplicate || (!own && existing.count(t) > 0);
-        }
-        return kept_shared && !(duplicate || nm_after > nm_before || open_after > open_before + rim_opened || nm_after + fold_after >= nm_before + fold_before);
+        return FoldRepairAccepted(vertices, faces, patch, cand, edge_faces, existing, on_rim, open_rim_folds, min_cos);
       };
       bool ok = acceptable(tris);
       if (!ok) {
