@@ -523,6 +523,26 @@ TEST(OptimizeSeeds, CrossingPlanesRankTwoSeedsOnTheIntersectionLineOrTheRims) {
   ExpectRankTwoOnFeatures("crossing-planes", [&](const Vec3& p) { return std::min(line(p), rim(p)); }, line, 12, 1.5);
 }
 
+// Each end of crossing-planes' line, where four rims meet, gets one seed exactly on it and none crowding it:
+// without the thinning on the last steps' targets two rank-3 seeds sat 0.1-0.4 spacings from the end, each
+// holding the other off it (docs/optimize-seeds.md, "Feature clearance").
+TEST(OptimizeSeeds, CrossingPlanesLineEndsGetOneSeedEach) {
+  const auto udf = MakeShape("crossing-planes");
+  for (uint64_t seed : {1, 2}) {
+    const SeedCloud out = OptimizeSeeds(*udf, Initial(*udf, 1000, seed), OptimizeSeedsOptions{}, Monitor::Null());
+    double mean_nn = 0.0;
+    NearestNeighbourCv(out.position, &mean_nn);
+    for (double y : {-0.5, 0.5}) {
+      const Vec3 end(0.0, y, 0.0);
+      std::vector<double> d;
+      for (const Vec3& p : out.position) d.push_back((p - end).norm());
+      std::sort(d.begin(), d.end());
+      EXPECT_LT(d[0], 1e-4 * udf->Domain().Diagonal()) << "seed " << seed << ", end y = " << y;
+      EXPECT_GT(d[1], 0.35 * mean_nn) << "seed " << seed << ", end y = " << y;
+    }
+  }
+}
+
 TEST(OptimizeSeeds, SphereWithDiscRankTwoSeedsOnTheEquator) {
   auto equator = [](const Vec3& p) { return std::hypot(std::hypot(p.x(), p.y()) - 0.5, p.z()); };
   ExpectRankTwoOnFeatures("sphere-disc", equator, equator, 20, 2.0);
