@@ -358,6 +358,12 @@ std::vector<Tri> EarClip(const std::vector<Vec3>& vertices, const std::vector<si
   return out;
 }
 
+/// An edge as its sorted vertex pair, and the faces (sorted) around each edge.
+using EdgeKey = std::pair<int, int>;
+using EdgeFaceMap = std::map<EdgeKey, std::vector<Tri>>;
+
+EdgeKey KeyOf(int u, int v) { return {std::min(u, v), std::max(u, v)}; }
+
 /// A triangulation of the projected patch (2-D coordinates `q` of the patch vertices `pv`) that keeps the
 /// patch's edges shared with faces outside it: those edges first, then every other vertex pair by increasing
 /// length whose segment stays inside the projected patch and crosses no edge taken; the triangles are the
@@ -367,16 +373,15 @@ std::vector<Tri> EarClip(const std::vector<Vec3>& vertices, const std::vector<si
 std::vector<Tri> GreedyTriangulation(const std::vector<Vec3>& vertices, const std::vector<Tri>& faces,
                                      const std::vector<size_t>& patch, const std::vector<int>& pv,
                                      std::unordered_map<int, Eigen::Vector2d>& q,
-                                     const std::map<std::pair<int, int>, std::vector<Tri>>& edge_faces,
+                                     const EdgeFaceMap& edge_faces,
                                      double min_quality) {
   auto inside = [&](const Eigen::Vector2d& c) { return InsidePatch(faces, patch, q, c); };
-  auto key = [](int u, int v) { return std::make_pair(std::min(u, v), std::max(u, v)); };
   std::set<Tri> own;
   for (size_t f : patch) own.insert(Sorted(faces[f]));
-  std::set<std::pair<int, int>> shared;
+  std::set<EdgeKey> shared;
   for (size_t f : patch)
     for (int k = 0; k < 3; ++k) {
-      const auto e = key(faces[f][static_cast<size_t>(k)], faces[f][static_cast<size_t>((k + 1) % 3)]);
+      const auto e = KeyOf(faces[f][static_cast<size_t>(k)], faces[f][static_cast<size_t>((k + 1) % 3)]);
       for (const Tri& t : edge_faces.at(e))
         if (!own.count(t)) shared.insert(e);
     }
@@ -403,7 +408,7 @@ std::vector<Tri> GreedyTriangulation(const std::vector<Vec3>& vertices, const st
   std::vector<std::pair<double, std::pair<int, int>>> candidates;
   for (size_t i = 0; i < pv.size(); ++i)
     for (size_t j = i + 1; j < pv.size(); ++j) {
-      const auto e = key(pv[i], pv[j]);
+      const auto e = KeyOf(pv[i], pv[j]);
       if (shared.count(e)) continue;
       const Eigen::Vector2d &A = q[e.first], &B = q[e.second];
       if (inside(0.25 * A + 0.75 * B) && inside(0.5 * (A + B)) && inside(0.75 * A + 0.25 * B))
@@ -448,11 +453,6 @@ void ReplaceFaces(std::vector<Tri>& faces, const std::vector<char>& gone, const 
   next.insert(next.end(), added.begin(), added.end());
   faces.swap(next);
 }
-
-using EdgeKey = std::pair<int, int>;
-using EdgeFaceMap = std::map<EdgeKey, std::vector<Tri>>;
-
-EdgeKey KeyOf(int u, int v) { return {std::min(u, v), std::max(u, v)}; }
 
 /// Step 4's fold: two faces of edge e on the same side of it, nearly coplanar (their third vertices'
 /// perpendiculars from the edge within acos(min_cos)).
@@ -545,59 +545,58 @@ bool FoldRepairAccepted(const std::vector<Vec3>& vertices, const std::vector<Tri
                         const std::vector<size_t>& patch, const std::vector<Tri>& cand, const EdgeFaceMap& edge_faces,
                         const std::set<Tri>& existing, const std::vector<char>& on_rim, bool open_rim_folds,
                         double min_cos) {
-    // The patch's edges before and after; accept when non-manifold plus folded edges drop, with no more
-    // non-manifold and no more boundary edges (beyond the rim folds opened, with `open_rim_folds`).
-    EdgeFaceMap after;
-    for (size_t f : patch)
-      for (int k = 0; k < 3; ++k) {
-        const EdgeKey e = KeyOf(faces[f][static_cast<size_t>(k)], faces[f][static_cast<size_t>((k + 1) % 3)]);
-        after.emplace(e, edge_faces.at(e));
+  // The patch's edges before and after.
+  EdgeFaceMap after;
+  for (size_t f : patch)
+    for (int k = 0; k < 3; ++k) {
+      const EdgeKey e = KeyOf(faces[f][static_cast<size_t>(k)], faces[f][static_cast<size_t>((k + 1) % 3)]);
+      after.emplace(e, edge_faces.at(e));
+    }
+  for (const Tri& t : cand)
+    for (int k = 0; k < 3; ++k) {
+      const EdgeKey e = KeyOf(t[static_cast<size_t>(k)], t[static_cast<size_t>((k + 1) % 3)]);
+      const auto it = edge_faces.find(e);
+      after.emplace(e, it == edge_faces.end() ? std::vector<Tri>() : it->second);
+    }
+  int nm_before = 0, nm_after = 0, open_before = 0, open_after = 0, fold_before = 0, fold_after = 0, rim_opened = 0;
+  bool kept_shared = true;
+  for (auto& [e, fs] : after) {
+    const bool was_open = fs.size() == 1, was_folded = fs.size() == 2 && FoldedEdge(vertices, e, fs, min_cos);
+    nm_before += fs.size() >= 3;
+    open_before += was_open;
+    fold_before += was_folded;
+    size_t own = 0;
+    for (size_t f : patch) {
+      const auto it = std::find(fs.begin(), fs.end(), Sorted(faces[f]));
+      if (it != fs.end()) {
+        fs.erase(it);
+        ++own;
       }
+    }
+    const bool shared = own > 0 && !fs.empty();  // also used by faces outside the patch
+    bool in_new = false;
     for (const Tri& t : cand)
-      for (int k = 0; k < 3; ++k) {
-        const EdgeKey e = KeyOf(t[static_cast<size_t>(k)], t[static_cast<size_t>((k + 1) % 3)]);
-        const auto it = edge_faces.find(e);
-        after.emplace(e, it == edge_faces.end() ? std::vector<Tri>() : it->second);
+      if ((t[0] == e.first || t[1] == e.first || t[2] == e.first) && (t[0] == e.second || t[1] == e.second || t[2] == e.second)) {
+        fs.push_back(t);
+        in_new = true;
       }
-    int nm_before = 0, nm_after = 0, open_before = 0, open_after = 0, fold_before = 0, fold_after = 0, rim_opened = 0;
-    bool kept_shared = true;
-    for (auto& [e, fs] : after) {
-      const bool was_open = fs.size() == 1, was_folded = fs.size() == 2 && FoldedEdge(vertices, e, fs, min_cos);
-      nm_before += fs.size() >= 3;
-      open_before += was_open;
-      fold_before += was_folded;
-      size_t own = 0;
-      for (size_t f : patch) {
-        const auto it = std::find(fs.begin(), fs.end(), Sorted(faces[f]));
-        if (it != fs.end()) {
-          fs.erase(it);
-          ++own;
-        }
-      }
-      const bool shared = own > 0 && !fs.empty();  // also used by faces outside the patch
-      bool in_new = false;
-      for (const Tri& t : cand)
-        if ((t[0] == e.first || t[1] == e.first || t[2] == e.first) && (t[0] == e.second || t[1] == e.second || t[2] == e.second)) {
-          fs.push_back(t);
-          in_new = true;
-        }
-      // An edge the patch shares with other faces stays: a branching curve is never cut off.
-      kept_shared = kept_shared && (!shared || in_new);
-      nm_after += fs.size() >= 3;
-      open_after += fs.size() == 1;
-      fold_after += fs.size() == 2 && FoldedEdge(vertices, e, fs, min_cos);
-      // A new boundary edge is a hole, unless allowed at an open rim: both faces were on one side of the
-      // edge and both its vertices are on the boundary (the fold's other side is empty).
-      rim_opened += open_rim_folds && fs.size() == 1 && was_folded && on_rim[static_cast<size_t>(e.first)] &&
-                    on_rim[static_cast<size_t>(e.second)];
-    }
-    bool duplicate = false;
-    for (const Tri& t : cand) {
-      bool own = false;
-      for (size_t f : patch) own = own || Sorted(faces[f]) == t;
-      duplicate = duplicate || (!own && existing.count(t) > 0);
-    }
-    return kept_shared && !(duplicate || nm_after > nm_before || open_after > open_before + rim_opened || nm_after + fold_after >= nm_before + fold_before);
+    // An edge the patch shares with other faces stays: a branching curve is never cut off.
+    kept_shared = kept_shared && (!shared || in_new);
+    nm_after += fs.size() >= 3;
+    open_after += fs.size() == 1;
+    fold_after += fs.size() == 2 && FoldedEdge(vertices, e, fs, min_cos);
+    // A new boundary edge is a hole, unless allowed at an open rim: both faces were on one side of the
+    // edge and both its vertices are on the boundary (the fold's other side is empty).
+    rim_opened += open_rim_folds && fs.size() == 1 && was_folded && on_rim[static_cast<size_t>(e.first)] &&
+                  on_rim[static_cast<size_t>(e.second)];
+  }
+  bool duplicate = false;
+  for (const Tri& t : cand) {
+    bool own = false;
+    for (size_t f : patch) own = own || Sorted(faces[f]) == t;
+    duplicate = duplicate || (!own && existing.count(t) > 0);
+  }
+  return kept_shared && !(duplicate || nm_after > nm_before || open_after > open_before + rim_opened || nm_after + fold_after >= nm_before + fold_before);
 }
 
 /// Step 4: re-triangulates flat folds. For each non-manifold edge (a, b), in edge order, the patch of faces
@@ -721,14 +720,14 @@ size_t RetriangulateFlatFolds(const std::vector<Vec3>& vertices, std::vector<Tri
 /// The faces around each edge of a face list, for the hole-closing steps: each edge's third vertices, and
 /// each vertex's neighbours along boundary edges (edges with one face).
 struct EdgeFans {
-  std::map<std::pair<int, int>, std::vector<int>> third;
+  std::map<EdgeKey, std::vector<int>> third;
   std::map<int, std::vector<int>> open;  // sorted
 
   explicit EdgeFans(const std::vector<Tri>& faces) {
     for (const Tri& t : faces)
       for (int k = 0; k < 3; ++k) {
         const int u = t[static_cast<size_t>(k)], v = t[static_cast<size_t>((k + 1) % 3)];
-        third[Key(u, v)].push_back(t[static_cast<size_t>((k + 2) % 3)]);
+        third[KeyOf(u, v)].push_back(t[static_cast<size_t>((k + 2) % 3)]);
       }
     for (const auto& [e, w] : third)
       if (w.size() == 1) {
@@ -737,16 +736,15 @@ struct EdgeFans {
       }
     for (auto& [v, nb] : open) std::sort(nb.begin(), nb.end());
   }
-  static std::pair<int, int> Key(int u, int v) { return {std::min(u, v), std::max(u, v)}; }
-  bool HasEdge(int u, int v) const { return third.count(Key(u, v)) > 0; }
+  bool HasEdge(int u, int v) const { return third.count(KeyOf(u, v)) > 0; }
   bool HasFace(int u, int v, int w) const {
-    const auto it = third.find(Key(u, v));
+    const auto it = third.find(KeyOf(u, v));
     return it != third.end() && std::find(it->second.begin(), it->second.end(), w) != it->second.end();
   }
   /// Whether a face (u, v, w) would lie over a face of edge u-v: third vertices within acos(min_cos) of
   /// each other seen from the edge.
   bool Over(const std::vector<Vec3>& vertices, int u, int v, int w, double min_cos) const {
-    const auto it = third.find(Key(u, v));
+    const auto it = third.find(KeyOf(u, v));
     if (it == third.end()) return false;
     for (int z : it->second)
       if (SameSideOfEdge(vertices, u, v, w, z, min_cos)) return true;
@@ -792,19 +790,17 @@ size_t CloseTriangularHoles(const std::vector<Vec3>& vertices, std::vector<Tri>&
 /// m (third vertices within acos(min_cos) of each other seen from the edge). Returns the faces split.
 size_t SplitFacesOverCracks(const std::vector<Vec3>& vertices, std::vector<Tri>& faces, double min_quality,
                             double min_cos, double max_sliver_quality) {
-  using Edge = std::pair<int, int>;
-  auto key = [](int u, int v) { return Edge(std::min(u, v), std::max(u, v)); };
   auto at = [&](int v) -> const Vec3& { return vertices[static_cast<size_t>(v)]; };
   size_t split = 0;
   for (int round = 0; round < 4; ++round) {
     const EdgeFans fans(faces);
-    std::map<Edge, size_t> face_of;       // edge -> (the last of) its faces
+    std::map<EdgeKey, size_t> face_of;    // edge -> (the last of) its faces
     std::map<int, std::set<int>> joined;  // vertex -> its neighbours along edges
     for (size_t f = 0; f < faces.size(); ++f) {
       const Tri& t = faces[f];
       for (int k = 0; k < 3; ++k) {
         const int u = t[static_cast<size_t>(k)], v = t[static_cast<size_t>((k + 1) % 3)];
-        face_of[key(u, v)] = f;
+        face_of[KeyOf(u, v)] = f;
         joined[u].insert(v);
         joined[v].insert(u);
       }
@@ -994,24 +990,21 @@ TriangleMesh ThinMesh(const Udf& udf, const TriangleMesh& thick, const ThinMeshO
   for (size_t f = 0; f < thinner.faces().size(); ++f)
     if (thinner.alive()[f]) kept.push_back(thinner.faces()[f]);
   // 4. Flat folds.
+  const double fold_min_cos = std::cos(options.fold_flatness_deg * M_PI / 180.0);
   if (options.fold_flatness_deg > 0.0) {
-    st.folds_retriangulated = RetriangulateFlatFolds(thick.vertices, kept, std::cos(options.fold_flatness_deg * M_PI / 180.0),
-                                                      options.degenerate_quality, false);
+    st.folds_retriangulated = RetriangulateFlatFolds(thick.vertices, kept, fold_min_cos, options.degenerate_quality, false);
     monitor.Info(Count(st.folds_retriangulated, "flat folds re-triangulated"));
   }
   // 5. Cracks (T-junctions), then triangular holes: three boundary edges that form a cycle are a junction
   // whose face the thinning (or the dual) lost; a true boundary loop of three edges does not occur in a mesh
   // of this resolution.
-  st.cracks_split = SplitFacesOverCracks(thick.vertices, kept, options.degenerate_quality,
-                                         std::cos(options.fold_flatness_deg * M_PI / 180.0), 0.1);
+  st.cracks_split = SplitFacesOverCracks(thick.vertices, kept, options.degenerate_quality, fold_min_cos, 0.1);
   if (st.cracks_split > 0) monitor.Info(Count(st.cracks_split, "faces split over a crack (T-junction)"));
-  st.holes_closed = CloseTriangularHoles(thick.vertices, kept, options.degenerate_quality,
-                                         std::cos(options.fold_flatness_deg * M_PI / 180.0));
+  st.holes_closed = CloseTriangularHoles(thick.vertices, kept, options.degenerate_quality, fold_min_cos);
   if (st.holes_closed > 0) monitor.Info(Count(st.holes_closed, "triangular holes closed"));
   // 6. Folds at open rims, once no other repair applies.
   if (options.fold_flatness_deg > 0.0) {
-    st.rim_folds_opened = RetriangulateFlatFolds(thick.vertices, kept, std::cos(options.fold_flatness_deg * M_PI / 180.0),
-                                                 options.degenerate_quality, true);
+    st.rim_folds_opened = RetriangulateFlatFolds(thick.vertices, kept, fold_min_cos, options.degenerate_quality, true);
     if (st.rim_folds_opened > 0) monitor.Info(Count(st.rim_folds_opened, "folds at open rims re-triangulated"));
   }
   Thinner oriented(std::move(kept), std::vector<double>());
