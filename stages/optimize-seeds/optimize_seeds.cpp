@@ -66,6 +66,20 @@ std::vector<Vec3> Tangents(const State& s) {
   return tangent;
 }
 
+// The mean distance of x from the tangent planes of seed i's cell samples, |n·(p − x) − d| (the terms of
+// the L1 energy, paper Eq. energy_l1); +inf for a cell without one. Decides between crowded feature seeds.
+double TangentMisfit(const CellSamples& cells, size_t i, const Vec3& x) {
+  double sum = 0.0;
+  size_t count = 0;
+  for (size_t m = cells.sample_offset[i]; m < cells.sample_offset[i + 1]; ++m) {
+    const Vec3& g = cells.gradient[m];
+    if (g.squaredNorm() < 0.25) continue;  // as in L1Step: no tangent plane
+    sum += std::abs(g.normalized().dot(cells.point[m] - x) - cells.distance[m]);
+    ++count;
+  }
+  return count > 0 ? sum / static_cast<double>(count) : INFINITY;
+}
+
 // Removes the seeds marked in `drop` from every array of the state, keeping the others' order.
 void EraseSeeds(State& s, const std::vector<char>& drop) {
   size_t k = 0;
@@ -87,7 +101,8 @@ void EraseSeeds(State& s, const std::vector<char>& drop) {
 
 // Feature-seed thinning (SeedsBesideFeatures) judged at `where` (the seeds' positions or their step
 // targets), at the state's ranks; the marked seeds leave the state and, if given, `carried` (a per-seed
-// array alongside it). Returns the count dropped.
+// array alongside it). `where` may be s.position or *carried: it is read before either changes. Returns the
+// count dropped.
 size_t ThinCrowded(State& s, const std::vector<Vec3>& where, const std::vector<double>& misfit, double limit,
                    std::vector<Vec3>* carried = nullptr) {
   std::vector<uint8_t> ranks(s.rank.size());
@@ -218,8 +233,8 @@ class Optimizer {
 
   // Paper Eq. (energy_l1_regularizer) for every seed, inside its cell. Returns the new (unprojected) positions.
   // features_only: only seeds whose cells have rank ≥ 2 (sharp edges, corners, rims) move.
-  // misfit_at_target (optional): per seed, the mean distance of its new position from its cell's tangent
-  // planes (world units; +inf for a seed that did not move).
+  // misfit_at_target (optional): per seed, TangentMisfit at its new position, from the solver's terms (+inf
+  // for a seed that did not move).
   std::vector<Vec3> L1Step(const State& s, const CellSamples& cells, bool features_only = false,
                            std::vector<double>* misfit_at_target = nullptr) {
     const long n = static_cast<long>(s.position.size());
@@ -268,6 +283,7 @@ class Optimizer {
         const L1TangentSolution solution = SolveL1Tangent(problem, solver);
         moved[i] = x0 + scale * solution.y;
         if (misfit_at_target) {
+          // TangentMisfit at the target, from the solver's (merged, weighted) terms.
           double sum = 0.0, weight = 0.0;
           for (size_t k = 0; k < problem.a.size(); ++k) {
             const double w = problem.w.empty() ? 1.0 : problem.w[k];
@@ -326,21 +342,9 @@ class Optimizer {
   // misfit, which decides between two crowded feature seeds, is the mean distance of its position from the
   // tangent planes of its cell's samples: zero on the corner itself. Returns the count dropped.
   size_t DropCrowded(State& s, const CellSamples& cells) const {
-    const size_t n = s.position.size();
-    std::vector<double> misfit(n, INFINITY);
-    for (size_t i = 0; i < n; ++i) {
-      double sum = 0.0;
-      size_t count = 0;
-      for (size_t m = cells.sample_offset[i]; m < cells.sample_offset[i + 1]; ++m) {
-        const Vec3& g = cells.gradient[m];
-        if (g.squaredNorm() < 0.25) continue;  // as in L1Step: no tangent plane
-        sum += std::abs(g.normalized().dot(cells.point[m] - s.position[i]) - cells.distance[m]);
-        ++count;
-      }
-      if (count > 0) misfit[i] = sum / static_cast<double>(count);
-    }
-    const std::vector<Vec3> where = s.position;
-    return ThinCrowded(s, where, misfit, options_.feature_clearance * MeanSpacing(s.position));
+    std::vector<double> misfit(s.position.size());
+    for (size_t i = 0; i < misfit.size(); ++i) misfit[i] = TangentMisfit(cells, i, s.position[i]);
+    return ThinCrowded(s, s.position, misfit, options_.feature_clearance * MeanSpacing(s.position));
   }
 
   // Mean and coefficient of variation of the nearest-neighbour distances (the spacing's evenness).
@@ -646,8 +650,7 @@ SeedCloud OptimizeSeeds(const Udf& udf, const SeedCloud& input, const OptimizeSe
     // Seeds whose steps meet are thinned before the move (the better fitting target stays): otherwise two
     // corner seeds both step onto one corner, Project undoes both moves as too near, and neither reaches it.
     if (options.feature_clearance > 0.0) {
-      const std::vector<Vec3> where = targets;
-      crowded += ThinCrowded(s, where, misfit, options.feature_clearance * opt.MeanSpacing(s.position), &targets);
+      crowded += ThinCrowded(s, targets, misfit, options.feature_clearance * opt.MeanSpacing(s.position), &targets);
     }
     const std::vector<Vec3> before = s.position;
     opt.Project(s, before, std::move(targets), 0.25 * opt.MeanSpacing(s.position));
