@@ -258,6 +258,14 @@ int AddFinOnRow3(TriangleMesh& m, const std::set<int>& skip = {}) {
   return base;
 }
 
+// The 6 x 6 grid with the whole fin of AddFinOnRow3 standing on it, every face in place.
+void ExpectGridWithWholeFin(const TriangleMesh& out) {
+  const TopologyStats topo = ComputeTopology(out);
+  EXPECT_EQ(topo.boundary_edges, 24u + 8u);  // the grid's outline and the fin's three free sides
+  EXPECT_EQ(topo.nonmanifold_edges, 6u);     // row 3
+  EXPECT_EQ(out.faces.size(), 72u + 12u);
+}
+
 TEST(ThinMesh, ANotchAtABranchingLineIsClosed) {
   const auto udf = MakeShape("disc");
   TriangleMesh m;
@@ -272,10 +280,7 @@ TEST(ThinMesh, ANotchAtABranchingLineIsClosed) {
   const TriangleMesh out = ThinMesh(*udf, m, ThinMeshOptions{}, Monitor::Null(), &stats);
   EXPECT_EQ(stats.holes_closed, 1u);
   EXPECT_TRUE(SortedFaces(out).count({v22, v23, v33}));
-  const TopologyStats topo = ComputeTopology(out);
-  EXPECT_EQ(topo.boundary_edges, 24u + 8u);  // the grid's outline and the fin's three free sides
-  EXPECT_EQ(topo.nonmanifold_edges, 6u);     // row 3
-  EXPECT_EQ(out.faces.size(), 72u + 12u);
+  ExpectGridWithWholeFin(out);
 }
 
 TEST(ThinMesh, AFaceOverACrackAtABranchingLineIsSplit) {
@@ -294,10 +299,7 @@ TEST(ThinMesh, AFaceOverACrackAtABranchingLineIsSplit) {
   EXPECT_EQ(stats.cracks_split, 1u);
   EXPECT_TRUE(SortedFaces(out).count({v13, v23, base + 2}));
   EXPECT_TRUE(SortedFaces(out).count({v23, v33, base + 2}));
-  const TopologyStats topo = ComputeTopology(out);
-  EXPECT_EQ(topo.boundary_edges, 24u + 8u);  // the grid's outline and the fin's three free sides
-  EXPECT_EQ(topo.nonmanifold_edges, 6u);     // row 3
-  EXPECT_EQ(out.faces.size(), 72u + 12u);
+  ExpectGridWithWholeFin(out);
 }
 
 TEST(ThinMesh, AFoldAtAnOpenRimBecomesBoundary) {
