@@ -325,6 +325,111 @@ TEST(EvaluateCd, MeshAgainstItselfIsAtTheSamplingFloor) {
   EXPECT_NEAR(Eval(Square(8), Square(8), more).cd_x1e3, floor_x1e3 / 2, 0.15 * floor_x1e3 / 2);
 }
 
+// ---- exact distances (no sampling floor) ----
+
+// Cube(n) with each side moved by `delta` along its outward normal, sides no longer sharing vertices.
+TriangleMesh CubeSidesDisplaced(int n, double delta) {
+  const TriangleMesh cube = Cube(n);
+  TriangleMesh out;
+  for (const Tri& t : cube.faces) {
+    const Vec3 c = (cube.vertices[t[0]] + cube.vertices[t[1]] + cube.vertices[t[2]]) / 3;
+    int axis = 0;
+    c.cwiseAbs().maxCoeff(&axis);
+    Vec3 shift = Vec3::Zero();
+    shift[axis] = c[axis] > 0 ? delta : -delta;
+    const int base = static_cast<int>(out.vertices.size());
+    for (int v : t) out.vertices.push_back(cube.vertices[v] + shift);
+    out.faces.push_back({base, base + 1, base + 2});
+  }
+  return out;
+}
+
+TEST(EvaluateExact, MeshAgainstItselfHasNoFloor) {
+  for (const TriangleMesh& mesh : {Cube(6), Sphere(3), Book(3)}) {
+    const Metrics m = Eval(mesh, mesh);
+    EXPECT_LT(m.exact.cd_x1e3, 1e-3);
+    EXPECT_LT(m.exact.hd_x1e3, 1e-3);
+    EXPECT_LT(m.exact.p99_x1e3, 1e-3);
+    EXPECT_LT(m.exact.ecd_x1e2, 1e-4);
+    EXPECT_GT(m.cd_x1e3, 1.0) << "the sampled CD of the same pair sits on its floor";
+  }
+}
+
+TEST(EvaluateExact, SidesDisplacedAlongTheirNormalsGiveTwiceTheDisplacement) {
+  for (double delta : {0.002, 0.02}) {
+    const Metrics m = Eval(CubeSidesDisplaced(6, delta), Cube(6));
+    EXPECT_NEAR(m.exact.cd_x1e3, 2 * delta * 1e3, 0.01 * 2 * delta * 1e3) << delta;
+    const double hd = delta / std::sqrt(3.0) * 1e3;  // the reference's diagonal is sqrt 3
+    EXPECT_NEAR(m.exact.hd_x1e3, hd, 0.01 * hd);
+    EXPECT_NEAR(m.exact.p99_x1e3, hd, 0.01 * hd);
+    EXPECT_NEAR(m.exact.hd_ref_mesh_x1e3, hd, 0.01 * hd);
+    EXPECT_NEAR(m.exact.hd_mesh_ref_x1e3, hd, 0.01 * hd);
+  }
+}
+
+TEST(EvaluateExact, MissingFaceGivesItsInradiusOneSided) {
+  // Square(4) without one right isosceles triangle of legs h = 1/4: a reference sample in the hole is
+  // nearest to the hole's nearest edge (the neighbours are coplanar), at most the inradius h (2 - sqrt2)/2
+  // away, and that distance averages r/3 over the triangle.
+  const TriangleMesh ref = Square(4);
+  TriangleMesh holed = ref;
+  holed.faces.erase(holed.faces.begin() + 10);  // in cell (1, 1): every edge shared with a neighbour
+  const double r = 0.25 * (2 - std::sqrt(2.0)) / 2, diagonal = std::sqrt(2.0);
+  const Metrics m = Eval(holed, ref);
+  EXPECT_LE(m.exact.hd_ref_mesh_x1e3, r / diagonal * 1e3 * (1 + 1e-9));
+  EXPECT_GT(m.exact.hd_ref_mesh_x1e3, 0.95 * r / diagonal * 1e3);
+  EXPECT_LT(m.exact.hd_mesh_ref_x1e3, 1e-9);
+  EXPECT_EQ(m.exact.hd_x1e3, m.exact.hd_ref_mesh_x1e3);
+  EXPECT_NEAR(m.exact.cd_x1e3, r / 3 / 32 * 1e3, 0.05 * r / 3 / 32 * 1e3);
+}
+
+TEST(EvaluateExact, NinetyNinthPercentileIgnoresOneStrayTriangle) {
+  TriangleMesh stray = Square(8);
+  const int base = static_cast<int>(stray.vertices.size());
+  stray.vertices.insert(stray.vertices.end(), {{0.5, 0.5, 0.3}, {0.51, 0.5, 0.3}, {0.5, 0.51, 0.3}});
+  stray.faces.push_back({base, base + 1, base + 2});
+  const Metrics m = Eval(stray, Square(8));
+  EXPECT_NEAR(m.exact.hd_x1e3, 0.3 / std::sqrt(2.0) * 1e3, 1e-6);
+  EXPECT_LT(m.exact.p99_x1e3, 1e-6);
+}
+
+TEST(EvaluateExact, EdgeChamferMeasuresHowFarTheSharpEdgesMoved) {
+  // The cube scaled by 1 + eps about its centre: every edge moves by eps/sqrt2 (half a diagonal of eps/2 per
+  // axis), more near the corners on the scaled side only by O(eps^2).
+  const double eps = 0.01;
+  const Metrics m = Eval(Transformed(Cube(6), 1 + eps, Vec3::Zero()), Cube(6));
+  const double moved = 0.5 * eps * std::sqrt(2.0);
+  EXPECT_NEAR(m.exact.ecd_x1e2, 2 * moved * 1e2, 0.03 * 2 * moved * 1e2);
+  EXPECT_NEAR(m.ref.sharp_length, 12.0, 1e-9);
+  // A smooth mesh against the cube: its edges are stood in for by the origin.
+  const Metrics none = Eval(Sphere(3), Cube(6));
+  EXPECT_EQ(none.mesh.sharp_length, 0.0);
+  EXPECT_GT(none.exact.ecd_x1e2, 2 * 0.5 * std::sqrt(2.0) * 1e2);
+  EXPECT_EQ(Eval(Cube(6), Sphere(3)).exact.ecd_x1e2, 0.0) << "a reference without sharp edges";
+}
+
+TEST(EvaluateExact, SharpEdgesAreTheCreasesAndTheCrossings) {
+  EXPECT_EQ(SharpEdges(Cube(3), 0.2).size(), 12u * 3);
+  EXPECT_TRUE(SharpEdges(Sphere(2), 0.2).empty());
+  EXPECT_TRUE(SharpEdges(Square(4), 0.2).empty()) << "a boundary is not a crease";
+  EXPECT_EQ(SharpEdges(Book(4), 0.2).size(), 1u) << "pages at 90 degrees meet at the spine";
+}
+
+TEST(EvaluateFloor, IsTheReferenceAgainstItsOtherSamples) {
+  EvaluateOptions o;
+  o.floor = true;
+  const Metrics self = Eval(Cube(6), Cube(6), o);
+  ASSERT_TRUE(self.has_floor);
+  // A mesh against itself under the sampled protocol is exactly its floor.
+  EXPECT_EQ(self.floor.cd_x1e3, self.cd_x1e3);
+  EXPECT_EQ(self.floor.hd_x1e3, self.hd_x1e3);
+  EXPECT_EQ(self.floor.ecd_x1e2, self.ecd_x1e2);
+  EXPECT_GT(self.floor.cd_x1e3, 5.0);  // about 7.7 for a cube at 100k samples (docs/evaluate.md)
+  const Metrics other = Eval(Sphere(3), Cube(6), o);
+  EXPECT_EQ(other.floor.cd_x1e3, self.floor.cd_x1e3) << "the floor depends on the reference only";
+  EXPECT_FALSE(Eval(Cube(6), Cube(6)).has_floor);
+}
+
 // ---- ECD ----
 
 TEST(EvaluateEcd, SphereReferenceHasNoEdgePointsSoEcdIsZero) {
@@ -492,11 +597,13 @@ TEST(EvaluateJson, SameBytesWhateverTheThreadCountAndInfIsAString) {
   EXPECT_EQ(one.find('\n'), one.size() - 1) << "one line";
   EXPECT_NE(one.find("\"nmcd_x1e3\": \"inf\""), std::string::npos) << one;
   EXPECT_EQ(one.find("seconds"), std::string::npos);
+  EXPECT_EQ(one.find("floor"), std::string::npos) << "floor keys only with --floor";
   EXPECT_EQ(one.rfind("{\"mesh\": \"a.ply\", \"reference\": \"b.obj\", \"samples\": 5000, ", 0), 0u) << one;
   // Fixed key order.
   size_t last = 0;
   for (const char* key : {"\"vertices\"", "\"faces\"", "\"cd_x1e3\"", "\"hd_x1e3\"", "\"ecd_x1e2\"", "\"tq\"", "\"td\"",
-                          "\"nmcd_x1e3\"", "\"euler_mesh\"", "\"euler_ref\"", "\"nonmanifold_edges\"",
+                          "\"nmcd_x1e3\"", "\"cd_exact_x1e3\"", "\"hd_exact_x1e3\"", "\"p99_exact_x1e3\"",
+                          "\"hd_exact_ref_mesh_x1e3\"", "\"hd_exact_mesh_ref_x1e3\"", "\"ecd_exact_x1e2\"", "\"euler_mesh\"", "\"euler_ref\"", "\"nonmanifold_edges\"",
                           "\"nonmanifold_vertices\"", "\"boundary_edges\"", "\"components\"", "\"ref_vertices\"",
                           "\"ref_faces\"", "\"ref_tq\"", "\"ref_nonmanifold_edges\"", "\"ref_components\""}) {
     const size_t at = one.find(key);
@@ -573,8 +680,11 @@ TEST_F(EvaluateExe, PrintsOneJsonLineReadsEveryFormatAndWritesAtomically) {
     EXPECT_EQ(std::system(cmd.c_str()), 0) << test::ReadBytes(dir_ / "m.json");
   }
   auto timed = Args("book3.ply", "book3.ply");
-  timed.push_back("--timings");
-  EXPECT_NE(RunProgram("evaluate", timed).out.find("\"seconds\": "), std::string::npos);
+  timed.insert(timed.end(), {"--timings", "--floor"});
+  const std::string with_floor = RunProgram("evaluate", timed).out;
+  EXPECT_NE(with_floor.find("\"seconds\": "), std::string::npos);
+  for (const char* key : {"\"cd_floor_x1e3\"", "\"hd_floor_x1e3\"", "\"ecd_floor_x1e2\"", "\"cd_exact_x1e3\""})
+    EXPECT_NE(with_floor.find(key), std::string::npos) << key << with_floor;
 }
 
 struct Failure {
@@ -609,7 +719,8 @@ TEST_F(EvaluateExe, FailuresExitWithTheDocumentedCodeAndOneLine) {
 TEST_F(EvaluateExe, HelpExplainsTheOptions) {
   const auto r = RunProgram("evaluate", {"--help"});
   EXPECT_EQ(r.exit_code, 0);
-  for (const char* flag : {"--input", "--reference", "--output", "--samples", "--nm-samples", "--seed", "--timings", "--threads"})
+  for (const char* flag : {"--input", "--reference", "--output", "--samples", "--nm-samples", "--edge-samples", "--floor",
+                           "--seed", "--timings", "--threads"})
     EXPECT_NE(r.out.find(flag), std::string::npos) << flag;
 }
 

@@ -16,12 +16,15 @@
 #include "common/morton.h"
 #include "common/errors.h"
 #include "common/rng.h"
+#include "common/triangle_bvh.h"
 
 namespace voroudf {
 namespace {
 
 // Queries go to FLANN in blocks so that progress can be reported between them.
 constexpr size_t kQueryBlock = 16384;
+// Exact-distance queries: blocks of consecutive Morton-ordered points, one hint chain per block.
+constexpr size_t kBvhBlock = 4096;
 
 // Surface-sample RNG streams of the two meshes: disjoint, so a mesh against itself shows the sampling floor
 // of the protocol instead of an artificial 0.
@@ -125,6 +128,7 @@ void EvaluateOptions::Check() const {
   if (!(edge_cos > 0 && edge_cos <= 1)) throw UsageError("edge cosine threshold must be in (0, 1]");
   if (!(weld_tolerance >= 0 && weld_tolerance < 0.1)) throw UsageError("weld tolerance must be in [0, 0.1)");
   if (empty_edge_points < 1) throw UsageError("the ECD stand-in needs at least one point");
+  if (edge_samples < 1 || edge_samples > 100000000) throw UsageError("--edge-samples must be in [1, 1e8]");
 }
 
 Frame ReferenceFrame(const TriangleMesh& reference) {
@@ -210,6 +214,52 @@ std::vector<double> NearestDistances(const std::vector<Vec3>& from, const std::v
     monitor.Advance(end - begin);
   }
   return distance;
+}
+
+std::vector<double> DistancesToTriangles(const std::vector<Vec3>& points, const TriangleMesh& mesh, Monitor& monitor) {
+  std::vector<double> distance(points.size());
+  if (points.empty()) return distance;
+  const TriangleBvh bvh(mesh.vertices, mesh.faces);
+  const std::vector<size_t> order = MortonOrder(points, BoundingBox(points));
+  const long long blocks = static_cast<long long>((points.size() + kBvhBlock - 1) / kBvhBlock);
+#pragma omp parallel for schedule(dynamic, 1)
+  for (long long b = 0; b < blocks; ++b) {
+    const size_t begin = static_cast<size_t>(b) * kBvhBlock, end = std::min(points.size(), begin + kBvhBlock);
+    int hint = -1;
+    for (size_t i = begin; i < end; ++i) {
+      const TriangleBvh::Hit hit = bvh.Closest(points[order[i]], hint);
+      hint = hit.slot;
+      distance[order[i]] = std::sqrt(hit.sq_distance);
+    }
+    monitor.Advance(end - begin);
+  }
+  return distance;
+}
+
+std::vector<double> DistancesToSegments(const std::vector<Vec3>& points, const std::vector<Vec3>& vertices,
+                                        const std::vector<Edge>& edges, Monitor& monitor) {
+  if (edges.empty()) throw Error("DistancesToSegments: no segment");
+  TriangleMesh segments;
+  segments.vertices = vertices;
+  segments.faces.reserve(edges.size());
+  for (const Edge& e : edges) segments.faces.push_back({e[0], e[1], e[1]});
+  return DistancesToTriangles(points, segments, monitor);
+}
+
+DistanceSummary Summarize(const std::vector<double>& d) {
+  if (d.empty()) throw NumericalError("distance summary of an empty set");
+  DistanceSummary s;
+  double sum = 0;
+  for (double x : d) {
+    sum += x;
+    s.max = std::max(s.max, x);
+  }
+  s.mean = sum / static_cast<double>(d.size());
+  std::vector<double> sorted = d;
+  const size_t rank = static_cast<size_t>(std::ceil(0.99 * static_cast<double>(d.size())));
+  std::nth_element(sorted.begin(), sorted.begin() + static_cast<long>(rank - 1), sorted.end());
+  s.p99 = sorted[rank - 1];
+  return s;
 }
 
 ChamferDistances Chamfer(const std::vector<Vec3>& a, const std::vector<Vec3>& b, Monitor& monitor) {
@@ -306,8 +356,29 @@ std::vector<Edge> NonManifoldEdges(const TriangleMesh& mesh) {
   return out;
 }
 
-std::vector<Vec3> SampleNonManifoldEdges(const TriangleMesh& mesh, size_t count, double* total_length) {
-  const std::vector<Edge> edges = NonManifoldEdges(mesh);
+std::vector<Edge> SharpEdges(const TriangleMesh& mesh, double cos_threshold) {
+  const EdgeFaces ef = BuildEdgeFaces(mesh.faces);
+  std::vector<Vec3> normal(mesh.faces.size(), Vec3::Zero());
+  for (size_t f = 0; f < mesh.faces.size(); ++f) {
+    const Tri& t = mesh.faces[f];
+    const Vec3 cross = (mesh.vertices[t[1]] - mesh.vertices[t[0]]).cross(mesh.vertices[t[2]] - mesh.vertices[t[0]]);
+    if (cross.norm() > 0) normal[f] = cross.normalized();
+  }
+  std::vector<Edge> out;
+  for (size_t e = 0; e < ef.edges.size(); ++e) {
+    const std::vector<int>& fs = ef.faces[e];
+    bool sharp = false;
+    for (size_t i = 0; i < fs.size() && !sharp; ++i)
+      for (size_t j = i + 1; j < fs.size() && !sharp; ++j)
+        sharp = !normal[fs[i]].isZero() && !normal[fs[j]].isZero() &&
+                std::abs(normal[fs[i]].dot(normal[fs[j]])) < cos_threshold;
+    if (sharp) out.push_back(ef.edges[e]);
+  }
+  return out;
+}
+
+std::vector<Vec3> SampleEdges(const TriangleMesh& mesh, const std::vector<Edge>& edges, size_t count,
+                              double* total_length) {
   std::vector<double> cumulative(edges.size());
   double total = 0;
   for (size_t e = 0; e < edges.size(); ++e) {
@@ -332,6 +403,10 @@ std::vector<Vec3> SampleNonManifoldEdges(const TriangleMesh& mesh, size_t count,
   return points;
 }
 
+std::vector<Vec3> SampleNonManifoldEdges(const TriangleMesh& mesh, size_t count, double* total_length) {
+  return SampleEdges(mesh, NonManifoldEdges(mesh), count, total_length);
+}
+
 double MeanTriangleQuality(const TriangleMesh& mesh) {
   const size_t nf = mesh.faces.size();
   if (nf == 0) return 0.0;
@@ -349,6 +424,63 @@ double MeanTriangleQuality(const TriangleMesh& mesh) {
 TopologyStats WeldedTopology(const TriangleMesh& mesh, double tolerance) {
   return ComputeTopology(WeldVertices(mesh, tolerance));
 }
+
+namespace {
+
+// Exact CD/HD/p99 (samples to the other mesh's triangles) and the exact ECD (sharp-edge samples to the other
+// mesh's sharp edges), docs/evaluate.md "Exact metrics". `*_welded` are the welded meshes in the frame.
+ExactMetrics ExactDistances(const TriangleMesh& mesh, const TriangleMesh& ref, const TriangleMesh& mesh_welded,
+                            const TriangleMesh& ref_welded, const SurfaceSamples& mesh_samples,
+                            const SurfaceSamples& ref_samples, const EvaluateOptions& options, Metrics& m,
+                            Monitor& monitor) {
+  ExactMetrics e;
+  const double diagonal = m.frame.ref_diagonal;
+  {
+    Task task(monitor, "exact CD/HD", ref_samples.points.size() + mesh_samples.points.size());
+    const DistanceSummary rm = Summarize(DistancesToTriangles(ref_samples.points, mesh, monitor));
+    const DistanceSummary mr = Summarize(DistancesToTriangles(mesh_samples.points, ref, monitor));
+    e.cd_x1e3 = (rm.mean + mr.mean) * 1e3;
+    e.hd_ref_mesh_x1e3 = rm.max / diagonal * 1e3;
+    e.hd_mesh_ref_x1e3 = mr.max / diagonal * 1e3;
+    e.hd_x1e3 = std::max(e.hd_ref_mesh_x1e3, e.hd_mesh_ref_x1e3);
+    e.p99_x1e3 = std::max(rm.p99, mr.p99) / diagonal * 1e3;
+  }
+  const std::vector<Edge> ref_sharp = SharpEdges(ref_welded, options.edge_cos);
+  std::vector<Edge> mesh_sharp = SharpEdges(mesh_welded, options.edge_cos);
+  const std::vector<Vec3> ref_points = SampleEdges(ref_welded, ref_sharp, options.edge_samples, &m.ref.sharp_length);
+  std::vector<Vec3> mesh_points = SampleEdges(mesh_welded, mesh_sharp, options.edge_samples, &m.mesh.sharp_length);
+  if (ref_points.empty()) return e;  // no sharp edge in the reference: 0, as the sampled ECD
+  // A mesh with no sharp edge is compared as one point at the origin (the sampled ECD's stand-in), so a
+  // method that loses every crease is penalised instead of skipped.
+  std::vector<Vec3> mesh_vertices = mesh_welded.vertices;
+  if (mesh_points.empty()) {
+    mesh_points.assign(1, Vec3::Zero());
+    mesh_vertices.assign(1, Vec3::Zero());
+    mesh_sharp.assign(1, Edge{0, 0});
+  }
+  Task task(monitor, "exact ECD", ref_points.size() + mesh_points.size());
+  const DistanceSummary rm = Summarize(DistancesToSegments(ref_points, mesh_vertices, mesh_sharp, monitor));
+  const DistanceSummary mr = Summarize(DistancesToSegments(mesh_points, ref_welded.vertices, ref_sharp, monitor));
+  e.ecd_x1e2 = (rm.mean + mr.mean) * 1e2;
+  return e;
+}
+
+// The sampled CD, HD and ECD of the reference against its own samples of the mesh's stream.
+FloorMetrics SampledFloor(const TriangleMesh& ref, const SurfaceSamples& ref_samples,
+                          const std::vector<Vec3>& ref_edge, const EvaluateOptions& options, double diagonal,
+                          Monitor& monitor) {
+  FloorMetrics f;
+  const SurfaceSamples other = SampleSurface(ref, options.samples, options.seed, kMeshStream);
+  Task task(monitor, "floor", 4 * options.samples);
+  const ChamferDistances c = Chamfer(ref_samples.points, other.points, monitor);
+  f.cd_x1e3 = c.SumOfMeans() * 1e3;
+  f.hd_x1e3 = c.MaxOfMaxima() / diagonal * 1e3;
+  const std::vector<Vec3> other_edge = EdgePoints(other, options.edge_radius, options.edge_cos, monitor);
+  if (!ref_edge.empty() && !other_edge.empty()) f.ecd_x1e2 = Chamfer(ref_edge, other_edge, monitor).SumOfMeans() * 1e2;
+  return f;
+}
+
+}  // namespace
 
 Metrics Evaluate(const TriangleMesh& mesh_in, const TriangleMesh& reference_in, const EvaluateOptions& options,
                  Monitor& monitor) {
@@ -425,6 +557,13 @@ Metrics Evaluate(const TriangleMesh& mesh_in, const TriangleMesh& reference_in, 
     Task task(monitor, "NM-CD", ref_nm.size() + mesh_nm.size());
     m.nmcd_x1e3 = Chamfer(ref_nm, mesh_nm, monitor).SumOfMeans() * 1e3;
   }
+  m.exact = ExactDistances(mesh, ref, mesh_welded, ref_welded, mesh_samples, ref_samples, options, m, monitor);
+  if (options.floor) {
+    m.has_floor = true;
+    m.floor = SampledFloor(ref, ref_samples, ref_edge, options, m.frame.ref_diagonal, monitor);
+  }
+  monitor.Info(Fmt("exact: CD %.6g (x1e3)  HD %.6g (x1e3)  p99 %.6g (x1e3)", m.exact.cd_x1e3, m.exact.hd_x1e3,
+                   m.exact.p99_x1e3) + Fmt("  ECD %.6g (x1e2)", m.exact.ecd_x1e2));
   monitor.Info(Fmt("CD %.6g (x1e3)  HD %.6g (x1e3)  ECD %.6g (x1e2)", m.cd_x1e3, m.hd_x1e3, m.ecd_x1e2) +
                Fmt("  TQ %.4g  TD %.0f  NM-CD %.6g (x1e3)", m.mesh.tq, static_cast<double>(m.td), m.nmcd_x1e3));
   return m;
@@ -454,6 +593,17 @@ std::string MetricsJson(const Metrics& m, const EvaluateOptions& options, const 
   num("tq", m.mesh.tq);
   count("td", m.td);
   num("nmcd_x1e3", m.nmcd_x1e3);
+  num("cd_exact_x1e3", m.exact.cd_x1e3);
+  num("hd_exact_x1e3", m.exact.hd_x1e3);
+  num("p99_exact_x1e3", m.exact.p99_x1e3);
+  num("hd_exact_ref_mesh_x1e3", m.exact.hd_ref_mesh_x1e3);
+  num("hd_exact_mesh_ref_x1e3", m.exact.hd_mesh_ref_x1e3);
+  num("ecd_exact_x1e2", m.exact.ecd_x1e2);
+  if (m.has_floor) {
+    num("cd_floor_x1e3", m.floor.cd_x1e3);
+    num("hd_floor_x1e3", m.floor.hd_x1e3);
+    num("ecd_floor_x1e2", m.floor.ecd_x1e2);
+  }
   count("euler_mesh", m.mesh.topology.euler);
   count("euler_ref", m.ref.topology.euler);
   auto report = [&](const std::string& prefix, const MeshReport& r) {
@@ -463,6 +613,7 @@ std::string MetricsJson(const Metrics& m, const EvaluateOptions& options, const 
     count((prefix + "components").c_str(), static_cast<long long>(r.topology.components));
     count((prefix + "edge_points").c_str(), static_cast<long long>(r.edge_points));
     num((prefix + "nonmanifold_length").c_str(), r.nonmanifold_length);
+    num((prefix + "sharp_length").c_str(), r.sharp_length);
   };
   report("", m.mesh);
   count("ref_vertices", static_cast<long long>(m.ref.vertices));

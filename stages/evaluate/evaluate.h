@@ -21,6 +21,8 @@ struct EvaluateOptions {
   double edge_cos = 0.2;         ///< ECD: a neighbour with |n.n'| below this makes an edge point (NMC)
   double weld_tolerance = 1e-7;  ///< TD and topology counts: weld distance in the normalised frame
   size_t empty_edge_points = 486;  ///< ECD: origin points standing in when the mesh has no edge point (NMC)
+  size_t edge_samples = 10000;   ///< exact ECD: samples per mesh along its sharp edges, by length (--edge-samples)
+  bool floor = false;            ///< also the sampled metrics of the reference against itself (--floor)
 
   /// Throws UsageError for values that cannot work.
   void Check() const;
@@ -61,6 +63,24 @@ SurfaceSamples SampleSurface(const TriangleMesh& mesh, size_t count, uint64_t se
 std::vector<double> NearestDistances(const std::vector<Vec3>& from, const std::vector<Vec3>& to,
                                      Monitor& monitor);
 
+/// For each point, the exact Euclidean distance to the closest point of `mesh`'s triangles (TriangleBvh;
+/// a degenerate triangle counts as its edges, so a face (a, b, b) is the segment a-b). Queries run in
+/// Morton order, each hinted with its predecessor's hit, which changes the cost and never the result.
+/// \pre `mesh` has a face and valid indices
+std::vector<double> DistancesToTriangles(const std::vector<Vec3>& points, const TriangleMesh& mesh, Monitor& monitor);
+
+/// For each point, the exact distance to the nearest of the segments `edges` of `vertices`
+/// (DistancesToTriangles on the degenerate faces (a, b, b)). \pre `edges` is non-empty
+std::vector<double> DistancesToSegments(const std::vector<Vec3>& points, const std::vector<Vec3>& vertices,
+                                        const std::vector<Edge>& edges, Monitor& monitor);
+
+/// Mean, maximum and 99th percentile (nearest rank: the ceil(0.99 n)-th smallest) of one-sided distances.
+struct DistanceSummary {
+  double mean = 0, max = 0, p99 = 0;
+};
+/// \pre `d` is non-empty. The sum is taken in index order.
+DistanceSummary Summarize(const std::vector<double>& d);
+
 /// Both directions of the point-set Chamfer/Hausdorff distances between `a` and `b`.
 struct ChamferDistances {
   double mean_ab = 0, mean_ba = 0;  ///< mean over a of d(a, B), mean over b of d(b, A)
@@ -84,9 +104,19 @@ std::vector<Vec3> EdgePoints(const SurfaceSamples& samples, double radius, doubl
 /// Non-manifold edges: edges shared by 3 or more faces, in BuildEdgeFaces order.
 std::vector<Edge> NonManifoldEdges(const TriangleMesh& mesh);
 
-/// `count` points spread evenly by arc length over the non-manifold edges (stratified: the point k sits at
-/// length (k + 1/2) L / count along the edges laid end to end, L their total length). Deterministic.
-/// \param total_length receives L (may be null). \returns an empty set if there is no such edge or L = 0.
+/// Sharp edges, the polyline counterpart of the ECD edge points: edges with two incident faces of non-zero
+/// area whose unit normals make |n.n'| < `cos_threshold` (sign-blind; on a non-manifold edge any pair counts,
+/// so two sheets crossing steeply make their common edge sharp). Boundary edges are not sharp.
+/// In BuildEdgeFaces order. \pre the mesh is welded (a crease between unshared vertices has no edge)
+std::vector<Edge> SharpEdges(const TriangleMesh& mesh, double cos_threshold);
+
+/// `count` points spread evenly by arc length over `edges` (stratified: the point k sits at length
+/// (k + 1/2) L / count along the edges laid end to end, L their total length). Deterministic.
+/// \param total_length receives L (may be null). \returns an empty set if there is no edge or L = 0.
+std::vector<Vec3> SampleEdges(const TriangleMesh& mesh, const std::vector<Edge>& edges, size_t count,
+                              double* total_length);
+
+/// SampleEdges over NonManifoldEdges(mesh).
 std::vector<Vec3> SampleNonManifoldEdges(const TriangleMesh& mesh, size_t count, double* total_length);
 
 /// Mean over all faces of TriangleQuality (Frey & Borouchaki): 1 for an equilateral triangle, 0 for a
@@ -105,6 +135,23 @@ struct MeshReport {
   double tq = 0;               ///< MeanTriangleQuality
   size_t edge_points = 0;      ///< ECD edge points among the surface samples
   double nonmanifold_length = 0;  ///< total length of the non-manifold edges in the normalised frame
+  double sharp_length = 0;     ///< total length of the sharp edges (SharpEdges) in the normalised frame
+};
+
+/// Exact distances between the two meshes (no sampling floor): one mesh's samples to the other's triangles.
+struct ExactMetrics {
+  double cd_x1e3 = 0;        ///< mean ref samples -> mesh triangles + mean mesh samples -> ref triangles, x1e3
+  double hd_x1e3 = 0;        ///< max of the two one-sided maxima / reference bbox diagonal, x1e3
+  double p99_x1e3 = 0;       ///< max of the two one-sided 99th percentiles / reference bbox diagonal, x1e3
+  double hd_ref_mesh_x1e3 = 0;  ///< one-sided: the worst reference sample (a part the mesh misses)
+  double hd_mesh_ref_x1e3 = 0;  ///< one-sided: the worst mesh sample (a stray or misplaced triangle)
+  double ecd_x1e2 = 0;       ///< sharp-edge samples -> the other mesh's sharp edges, both means summed, x1e2
+};
+
+/// The sampled CD, HD and ECD of the reference against itself (its samples of the mesh's RNG stream in
+/// place of the mesh's): the part of the sampled metrics that is sampling noise.
+struct FloorMetrics {
+  double cd_x1e3 = 0, hd_x1e3 = 0, ecd_x1e2 = 0;
 };
 
 struct Metrics {
@@ -113,6 +160,9 @@ struct Metrics {
   double ecd_x1e2 = 0;   ///< edge Chamfer (sum of means) x1e2
   double nmcd_x1e3 = 0;  ///< non-manifold Chamfer (sum of means) x1e3; +infinity if only one side has such edges
   long long td = 0;      ///< |chi(mesh) - chi(ref)|
+  ExactMetrics exact;
+  bool has_floor = false;  ///< `floor` computed (EvaluateOptions::floor)
+  FloorMetrics floor;
   MeshReport mesh, ref;
   Frame frame;
 };

@@ -15,7 +15,8 @@ int main(int argc, char** argv) {
 
   voroudf::StageCli cli("evaluate",
                         "Computes CD, HD, ECD, TQ, TD and NM-CD of a mesh against a reference mesh in the "
-                        "reference's normalised frame; prints one line of JSON, or writes it to -o.");
+                        "reference's normalised frame, sampled (the paper's protocol) and exact (samples to the "
+                        "other mesh's triangles); prints one line of JSON, or writes it to -o.");
   cli.AddInput(&input, "mesh under test (.ply, .obj, .off or .stl)");
   cli.app().add_option("--reference", reference, "reference mesh (.ply, .obj, .off or .stl)")->required();
   cli.AddExtraOutput("-o,--output", &output, "write the JSON here (atomically) instead of stdout");
@@ -23,6 +24,9 @@ int main(int argc, char** argv) {
   auto& app = cli.app();
   app.add_option("--samples", options.samples, "area-uniform surface samples per mesh (CD, HD, ECD)");
   app.add_option("--nm-samples", options.nm_samples, "samples per mesh along its non-manifold edges (NM-CD)");
+  app.add_option("--edge-samples", options.edge_samples, "samples per mesh along its sharp edges (exact ECD)");
+  app.add_flag("--floor", options.floor,
+               "also the sampled CD/HD/ECD of the reference against itself (keys *_floor_*): their sampling floor");
   // Off by default: wall-clock time would make the output bytes differ from run to run.
   app.add_flag("--timings", timings, "add the wall-clock seconds to the JSON (key \"seconds\")");
 
