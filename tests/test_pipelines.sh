@@ -65,6 +65,11 @@ case "$WHAT" in
       > "$TMP/log" 2>&1 || { cat "$TMP/log"; fail "the benchmark driver failed"; }
     grep -q '^| cad | 2 | 1 |' "$TMP/bench/results.md" || { cat "$TMP/bench/results.md"; fail "no table row"; }
     grep -q '^cad,ball,' "$TMP/bench/results.csv" || fail "no CSV row for the good mesh"
+    grep -q '| CD | CD floor | CD exact |' "$TMP/bench/results.md" || fail "no sampled/floor/exact columns"
+    grep -q '^- cad: ball [0-9.]* (ref->mesh' "$TMP/bench/results.md" || fail "no largest-exact-HD list"
+    /usr/bin/python3 -c "import csv,sys; r=[r for r in csv.DictReader(open(sys.argv[1])) if r['shape']=='ball'][0]; \
+      sys.exit(0 if 0 < float(r['cd_exact_x1e3']) < float(r['cd_x1e3']) and float(r['cd_floor_x1e3']) > 0 else 1)" \
+      "$TMP/bench/results.csv" || fail "exact CD not between 0 and the sampled CD, or no floor"
     grep -q '^cad,broken,.*exit 3' "$TMP/bench/results.csv" || { cat "$TMP/bench/results.csv"; fail "no error row"; }
     ;;
   *) fail "unknown test '$WHAT'" ;;
