@@ -23,11 +23,14 @@ class StageCli {
 
   CLI::App& app() { return app_; }
 
-  /// -i/--input (required).
+  /// -i/--input (required). `-` reads stdin.
   CLI::Option* AddInput(std::string* path, const std::string& description);
-  /// -o/--output (required); checked for writability before any work starts.
+  /// A further input file (e.g. --reference); `-` reads stdin, which at most one input may do.
+  CLI::Option* AddExtraInput(const std::string& flag, std::string* path, const std::string& description);
+  /// -o/--output (required). Its temporary file is created before any work starts; `-` writes stdout.
   CLI::Option* AddOutput(std::string* path, const std::string& description);
-  /// An extra optional output file (e.g. --labels); checked like -o when given.
+  /// An extra optional output file (e.g. --labels), handled like -o when given. All outputs of a stage are
+  /// published together or not at all (common/atomic_file.h).
   CLI::Option* AddExtraOutput(const std::string& flag, std::string* path, const std::string& description);
   /// Leaves an already added option (by its long name, e.g. "--trace") out of the provenance's option list:
   /// for options that do not change the results, such as debugging output.
@@ -48,8 +51,10 @@ class StageCli {
   /// Provenance for output headers: the program, its result-changing options and the UDF SPEC.
   Provenance provenance() const;
 
-  /// Parses argv; sets threads and verbosity; runs `check` (option validation, may throw UsageError);
-  /// checks outputs are writable; echoes the effective options; runs `body`. Returns the exit code.
+  /// Parses argv, refusing numbers that do not fit their option (a sign on an unsigned option, digits
+  /// past its type, a non-finite real); sets threads and verbosity; runs `check` (option validation, may
+  /// throw UsageError); creates the outputs' temporary files (OutputSet); echoes the effective options;
+  /// runs `body`, whose writes of the outputs go into the set; publishes the set. Returns the exit code.
   int Run(int argc, char** argv, const std::function<void()>& check, const std::function<void(Monitor&)>& body);
 
  private:
@@ -62,6 +67,9 @@ class StageCli {
   bool quiet_ = false;
   std::string* udf_spec_ = nullptr;
   UdfSourceOptions udf_options_;
+  void CheckBeforeWork() const;
+
+  std::vector<std::string*> inputs_;
   std::vector<std::string*> outputs_;
   std::set<std::string> non_semantic_;  ///< options that do not change results (left out of provenance)
 };

@@ -18,6 +18,7 @@
 #include <thread>
 #include <vector>
 
+#include "common/cleanup.h"
 #include "common/errors.h"
 #include "common/udf_spec.h"
 
@@ -116,6 +117,12 @@ ExecUdf::ExecUdf(const std::string& command, const ExecUdfOptions& options) : co
     close(to_child_), close(from_child_);
     throw InputError("exec:" + command_, std::string("cannot run /bin/sh: ") + std::strerror(rc));
   }
+  pgid_ = pid_;
+  try {
+    RegisterChildProcessGroup(pgid_);  // a signal to us ends the server's group too
+  } catch (const Error&) {
+    Fail("too many exec: sources at once");
+  }
   fcntl(to_child_, F_SETFL, fcntl(to_child_, F_GETFL) | O_NONBLOCK);
   fcntl(from_child_, F_SETFL, fcntl(from_child_, F_GETFL) | O_NONBLOCK);
 
@@ -145,38 +152,36 @@ ExecUdf::ExecUdf(const std::string& command, const ExecUdfOptions& options) : co
 ExecUdf::~ExecUdf() {
   if (to_child_ >= 0) close(to_child_);  // EOF on the server's stdin: the protocol's "goodbye"
   to_child_ = -1;
-  if (pid_ > 0) Reap(2.0);
+  Reap(2.0);
   if (from_child_ >= 0) close(from_child_);
 }
 
 bool ExecUdf::Reap(double wait_s) const {
-  // Waits for the process to exit on its own, else SIGTERMs then SIGKILLs its process group; always
-  // reaps it, so no zombie stays behind. Returns whether it exited on its own.
-  if (pid_ <= 0) return true;
-  int status = 0;
+  // Waits up to wait_s for sh to exit on its own (keeping its status for messages); then whatever is left
+  // of its process group (sh itself, or a server or child it started, whether or not sh has exited) gets
+  // SIGTERM, and SIGKILL after kGrace_s. Always reaps sh, so no zombie stays behind. Returns whether sh
+  // exited on its own.
+  if (pgid_ <= 0) return true;
+  bool exited = pid_ <= 0;
   const auto give_up = Clock::now() + std::chrono::duration<double>(wait_s);
-  for (;;) {
+  while (!exited) {
+    int status = 0;
     const pid_t r = waitpid(pid_, &status, WNOHANG);
     if (r == pid_ || r < 0) {
       if (r == pid_) exit_status_ = status;
       pid_ = -1;
-      return true;
+      exited = true;
+      break;
     }
     if (Clock::now() >= give_up) break;
     std::this_thread::sleep_for(std::chrono::milliseconds(5));
   }
-  kill(-pid_, SIGTERM);
-  const auto kill_deadline = Clock::now() + std::chrono::milliseconds(500);
-  while (waitpid(pid_, &status, WNOHANG) == 0) {
-    if (Clock::now() >= kill_deadline) {
-      kill(-pid_, SIGKILL);
-      waitpid(pid_, &status, 0);
-      break;
-    }
-    std::this_thread::sleep_for(std::chrono::milliseconds(5));
-  }
+  TerminateProcessGroup(pgid_, kGrace_s);
+  if (pid_ > 0) waitpid(pid_, nullptr, 0);  // killed above (or already reaped there: ECHILD)
   pid_ = -1;
-  return false;
+  UnregisterChildProcessGroup(pgid_);
+  pgid_ = -1;
+  return exited;
 }
 
 void ExecUdf::Fail(const std::string& problem) const {
@@ -280,7 +285,7 @@ void ExecUdf::EvaluateChunk(const Vec3* points, size_t count, double* distance, 
     // An exception cannot leave an OpenMP region (std::terminate); end as the top-level handler would.
     std::fprintf(stderr, "%s: error: %s\n", program_invocation_short_name, e.what());
     std::fflush(stderr);
-    _exit(kExitBadInput);
+    CleanUpAndExit(kExitBadInput);
   }
 }
 

@@ -23,6 +23,10 @@ struct ExecUdfOptions {
 /// blocked around writes, and the process group is killed and reaped. After such an error every
 /// further query fails with the same error.
 ///
+/// The server's whole process group ends with us on every path: at the end (EOF on its stdin, up to 2 s
+/// to exit, then SIGTERM and SIGKILL 0.5 s later to whatever of the group is left, whether or not sh has
+/// exited), on errors, and on SIGINT/SIGTERM/SIGHUP to the stage (common/cleanup.h).
+///
 /// Thread-safe: queries are serialised by a mutex. Evaluate() sends a whole batch as requests of
 /// max_batch points from the calling thread; EvaluateChunk() called from inside an OpenMP parallel
 /// region cannot throw across it, so there an error prints `PROGRAM: error: ...` and ends the process
@@ -62,7 +66,9 @@ class ExecUdf : public Udf {
   Box domain_;
   std::string server_name_;
   mutable std::mutex mutex_;
-  mutable pid_t pid_ = -1;
+  static constexpr double kGrace_s = 0.5;  ///< SIGTERM to SIGKILL
+  mutable pid_t pid_ = -1;   // sh, until reaped
+  mutable pid_t pgid_ = -1;  // its process group, until ended
   mutable int to_child_ = -1;
   mutable int from_child_ = -1;
   mutable int exit_status_ = -1;  // raw waitpid status once reaped

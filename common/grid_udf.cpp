@@ -10,6 +10,7 @@
 
 #include "common/atomic_file.h"
 #include "common/errors.h"
+#include "common/input_file.h"
 #include "common/udf_spec.h"
 
 #include <Eigen/Eigenvalues>
@@ -19,15 +20,6 @@ namespace {
 
 // Below kNormalBand grid spacings from the zero set the gradient comes from the Hessian of q (see EvaluateChunk).
 constexpr double kNormalBand = 0.25;
-
-std::string ReadAll(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path, std::string("cannot open: ") + std::strerror(errno));
-  std::ostringstream s;
-  s << in.rdbuf();
-  if (in.bad()) throw InputError(path, "read error");
-  return s.str();
-}
 
 bool FileExists(const std::string& path) {
   struct stat st;
@@ -104,37 +96,43 @@ Stencil AxisStencil(double u, size_t n) {
 
 }  // namespace
 
-NpyArray ReadNpyFloat32(const std::string& path) {
-  // The header is read first and the data straight into the array: a 512^3 grid is 512 MB, no copy.
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path, std::string("cannot open: ") + std::strerror(errno));
-  in.seekg(0, std::ios::end);
-  const size_t file_size = static_cast<size_t>(in.tellg());
-  in.seekg(0);
-  char preamble[12] = {0};
-  in.read(preamble, std::min<size_t>(12, file_size));
-  if (file_size < 10 || std::memcmp(preamble, "\x93NUMPY", 6) != 0)
+namespace {
+
+// Where the header of a .npy file ends (the data's offset), from its first bytes `pre` (at least 12, or
+// the whole file if shorter); `file_size` is the size of the whole file.
+size_t NpyHeaderEnd(const std::string& pre, size_t file_size, const std::string& path) {
+  if (file_size < 10 || pre.size() < 10 || std::memcmp(pre.data(), "\x93NUMPY", 6) != 0)
     throw InputError(path, "not a NumPy .npy file (no \\x93NUMPY magic)");
-  const int major = static_cast<unsigned char>(preamble[6]);
+  const int major = static_cast<unsigned char>(pre[6]);
   size_t header_len, offset;
   if (major == 1) {
-    header_len = static_cast<unsigned char>(preamble[8]) | (static_cast<size_t>(static_cast<unsigned char>(preamble[9])) << 8);
+    header_len = static_cast<unsigned char>(pre[8]) | (static_cast<size_t>(static_cast<unsigned char>(pre[9])) << 8);
     offset = 10;
   } else if (major == 2 || major == 3) {
-    if (file_size < 12) throw InputError(path, "truncated NumPy header");
+    if (file_size < 12 || pre.size() < 12) throw InputError(path, "truncated NumPy header");
     uint32_t len;
-    std::memcpy(&len, preamble + 8, 4);
+    std::memcpy(&len, pre.data() + 8, 4);
     header_len = len;
     offset = 12;
   } else {
     throw InputError(path, "unsupported .npy format version " + std::to_string(major) + " (expected 1, 2 or 3)");
   }
   if (file_size < offset + header_len) throw InputError(path, "truncated NumPy header");
-  std::string header(header_len, '\0');
-  in.seekg(static_cast<std::streamoff>(offset));
-  in.read(header.data(), static_cast<std::streamsize>(header_len));
-  offset += header_len;
+  return offset + header_len;
+}
 
+struct NpyLayout {
+  std::vector<size_t> shape;
+  size_t data_offset = 0;
+  size_t count = 1;
+};
+
+// The layout from `head`, the file's bytes up to at least NpyHeaderEnd; checks the data against file_size.
+NpyLayout ParseNpyLayout(const std::string& head, size_t file_size, const std::string& path) {
+  NpyLayout layout;
+  layout.data_offset = NpyHeaderEnd(head, file_size, path);
+  const size_t begin = static_cast<unsigned char>(head[6]) == 1 ? 10 : 12;
+  const std::string header = head.substr(begin, layout.data_offset - begin);
   std::string descr = HeaderValue(header, "descr", path);
   descr.erase(std::remove_if(descr.begin(), descr.end(), [](char c) { return c == '\'' || c == '"'; }), descr.end());
   if (descr != "<f4" && descr != "|f4")
@@ -144,34 +142,66 @@ NpyArray ReadNpyFloat32(const std::string& path) {
   if (fortran != "False")
     throw InputError(path, "the array is in Fortran order: expected C order (save np.ascontiguousarray(arr))");
   const std::string shape_text = HeaderValue(header, "shape", path);
-  NpyArray array;
-  {
-    std::string digits;
-    for (char c : shape_text) {
-      if (std::isdigit(static_cast<unsigned char>(c))) {
-        digits += c;
-      } else {
-        if (!digits.empty()) array.shape.push_back(std::stoull(digits));
-        digits.clear();
-        if (c != '(' && c != ')' && c != ',' && c != ' ' && c != 'L')
-          throw InputError(path, "malformed shape " + shape_text + " in the NumPy header");
-      }
+  std::string digits;
+  auto flush = [&] {
+    if (digits.empty()) return;
+    if (digits.size() > 12) throw InputError(path, "array too large: shape " + shape_text);
+    layout.shape.push_back(std::stoull(digits));
+    digits.clear();
+  };
+  for (char c : shape_text) {
+    if (std::isdigit(static_cast<unsigned char>(c))) {
+      digits += c;
+      continue;
     }
+    flush();
+    if (c != '(' && c != ')' && c != ',' && c != ' ' && c != 'L')
+      throw InputError(path, "malformed shape " + shape_text + " in the NumPy header");
   }
-  size_t count = 1;
-  for (size_t s : array.shape) {
-    if (s != 0 && count > (size_t(1) << 40) / s) throw InputError(path, "array too large: shape " + shape_text);
-    count *= s;
+  flush();
+  for (size_t n : layout.shape) {
+    if (n != 0 && layout.count > (size_t(1) << 40) / n) throw InputError(path, "array too large: shape " + shape_text);
+    layout.count *= n;
   }
-  const size_t need = count * sizeof(float);
-  if (file_size - offset < need)
-    throw InputError(path, "truncated: shape " + shape_text + " needs " + std::to_string(need) + " data bytes, the file has " +
-                               std::to_string(file_size - offset));
-  if (file_size - offset > need)
-    throw InputError(path, "has " + std::to_string(file_size - offset - need) + " bytes after the array of shape " + shape_text);
-  array.data.resize(count);
+  const size_t need = layout.count * sizeof(float), have = file_size - layout.data_offset;
+  if (have < need)
+    throw InputError(path, "truncated: shape " + shape_text + " needs " + std::to_string(need) +
+                               " data bytes, the file has " + std::to_string(have));
+  if (have > need)
+    throw InputError(path, "has " + std::to_string(have - need) + " bytes after the array of shape " + shape_text);
+  return layout;
+}
+
+}  // namespace
+
+NpyArray ParseNpyFloat32(const std::string& bytes, const std::string& name) {
+  const NpyLayout layout = ParseNpyLayout(bytes, bytes.size(), name);
+  NpyArray array;
+  array.shape = layout.shape;
+  array.data.resize(layout.count);
+  if (layout.count > 0) std::memcpy(array.data.data(), bytes.data() + layout.data_offset, layout.count * sizeof(float));
+  return array;
+}
+
+NpyArray ReadNpyFloat32(const std::string& path) {
+  // The header is read first and the data straight into the array: a 512^3 grid is 512 MB, no copy.
+  CheckInputFile(path);
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(path, std::string("cannot open: ") + std::strerror(errno));
+  in.seekg(0, std::ios::end);
+  const size_t file_size = static_cast<size_t>(in.tellg());
+  in.seekg(0);
+  std::string head(std::min<size_t>(12, file_size), '\0');
+  in.read(head.data(), static_cast<std::streamsize>(head.size()));
+  head.resize(NpyHeaderEnd(head, file_size, path));
+  in.seekg(0);
+  in.read(head.data(), static_cast<std::streamsize>(head.size()));
+  const NpyLayout layout = ParseNpyLayout(head, file_size, path);
+  NpyArray array;
+  array.shape = layout.shape;
+  array.data.resize(layout.count);
   // The machine is little-endian (x86-64, arm64), like '<f4'.
-  in.read(reinterpret_cast<char*>(array.data.data()), static_cast<std::streamsize>(need));
+  in.read(reinterpret_cast<char*>(array.data.data()), static_cast<std::streamsize>(layout.count * sizeof(float)));
   if (!in) throw InputError(path, "read error in the array data");
   return array;
 }
@@ -209,11 +239,13 @@ Box ParseBoxOption(const std::string& text) {
   Box box{Vec3(v[0], v[1], v[2]), Vec3(v[3], v[4], v[5])};
   if (!(box.min.array() < box.max.array()).all())
     throw UsageError("--udf-box '" + text + "': each min must be below its max");
+  if (!std::isfinite(box.Diagonal())) throw UsageError("--udf-box '" + text + "': the box's diagonal overflows");
   return box;
 }
 
-Box ReadBoxJson(const std::string& path) {
-  const std::string text = ReadAll(path);
+Box ReadBoxJson(const std::string& path) { return ParseBoxJson(ReadInputBytes(path), path); }
+
+Box ParseBoxJson(const std::string& text, const std::string& path) {
   const size_t key = text.find("\"box\"");
   if (key == std::string::npos) throw InputError(path, "no \"box\" key (expected {\"box\": [[x0,y0,z0],[x1,y1,z1]]})");
   size_t pos = key + 5;
@@ -247,7 +279,10 @@ Box ReadBoxJson(const std::string& path) {
   expect(']');
   if (!(corner[0].array() < corner[1].array()).all())
     throw InputError(path, "\"box\": each min must be below its max");
-  return Box{corner[0], corner[1]};
+  const Box box{corner[0], corner[1]};
+  // Every length in voroudf is relative to the diagonal: it must be a finite number.
+  if (!std::isfinite(box.Diagonal())) throw InputError(path, "\"box\": its diagonal overflows (box too large)");
+  return box;
 }
 
 GridUdf::GridUdf(const std::vector<float>& values, std::array<size_t, 3> dims, const Box& box,

@@ -20,6 +20,8 @@ struct NpyArray {
 /// ('<f4') in C order; anything else (another dtype, Fortran order, a truncated file) is an InputError
 /// that says what was found and what to do.
 NpyArray ReadNpyFloat32(const std::string& path);
+/// The same from a whole .npy file's bytes in memory; `name` names it in messages.
+NpyArray ParseNpyFloat32(const std::string& bytes, const std::string& name);
 
 /// Writes a little-endian float32 C-order .npy (version 1.0) atomically. Throws OutputError.
 void WriteNpyFloat32(const std::string& path, const std::vector<size_t>& shape, const std::vector<float>& data);
@@ -30,6 +32,8 @@ Box ParseBoxOption(const std::string& text);
 
 /// Reads a sidecar `{"box": [[x0,y0,z0],[x1,y1,z1]]}` (other keys are ignored). Throws InputError.
 Box ReadBoxJson(const std::string& path);
+/// The same from the sidecar's text; `path` names it in messages.
+Box ParseBoxJson(const std::string& text, const std::string& path);
 
 /// A UDF sampled at the nodes of a regular grid:
 /// value[i][j][k] (C order, k fastest) is d at box.min + (i, j, k) * box.Extent() / (n - 1), so the first

@@ -1,12 +1,14 @@
 #include "formats/labels_io.h"
 
 #include "common/errors.h"
+#include "common/input_file.h"
 #include "formats/kinds.h"
 
 namespace voroudf {
 
-LabeledSamples ReadLabels(const std::string& path) {
-  const ply::File file = ply::Read(path);
+LabeledSamples ReadLabels(const std::string& file_path) {
+  const ply::File file = ply::Read(file_path);
+  const std::string path = InputName(file_path);
   CheckDeclaredKind(file, path, "labels", kLabelsFormatVersion);
   const ply::Element& v = RequireElement(file, path, "vertex", "labels");
   const auto& x = RequireScalar(v, path, "x");
@@ -45,7 +47,11 @@ void WriteLabels(const std::string& path, const LabeledSamples& s, const Provena
   file.comments = ProvenanceComments("labels", kLabelsFormatVersion, provenance);
   ply::Element v = MakeVertexElement(s.position);
   v.properties.push_back(MakeScalar("label", ply::Type::kInt32, std::vector<double>(s.label.begin(), s.label.end())));
-  v.properties.push_back(MakeScalar("dist", ply::Type::kFloat32, s.dist));
+  // An unreached sample (label -1) has no geodesic distance: written as -1, so every value is finite.
+  std::vector<double> dist = s.dist;
+  for (size_t i = 0; i < dist.size() && i < s.label.size(); ++i)
+    if (s.label[i] < 0) dist[i] = -1.0;
+  v.properties.push_back(MakeScalar("dist", ply::Type::kFloat32, std::move(dist)));
   file.elements.push_back(std::move(v));
   if (!s.edges.empty()) file.elements.push_back(MakeEdgeElement(s.edges));
   ply::Write(path, file);

@@ -10,6 +10,7 @@
 #include <unordered_map>
 
 #include "common/errors.h"
+#include "common/input_file.h"
 #include "formats/kinds.h"
 #include "formats/ply.h"
 
@@ -24,11 +25,7 @@ std::string LowerExtension(const std::string& path) {
   return ext;
 }
 
-std::string ReadBytes(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path, std::string("cannot open: ") + std::strerror(errno));
-  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-}
+std::string ReadBytes(const std::string& path) { return ReadInputBytes(path); }
 
 // Appends polygon `poly` as a triangle fan after checking its indices.
 void AddPolygon(TriangleMesh& mesh, const std::vector<long long>& poly, size_t num_vertices, const std::string& path,
@@ -95,8 +92,18 @@ TriangleMesh ReadObj(const std::string& path) {
   return mesh;
 }
 
+// An OFF index or count: an integer-valued number in [0, limit].
+long long ParseIndex(const std::string& token, double limit, const std::string& path, int line, const char* what) {
+  const double v = ParseNumber(token, path, line);
+  if (!(v >= 0 && v <= limit) || v != std::floor(v))
+    throw InputError(path, "line " + std::to_string(line) + ": " + what + " '" + token + "' is not an integer in [0, " +
+                               std::to_string(static_cast<long long>(limit)) + "]");
+  return static_cast<long long>(v);
+}
+
 TriangleMesh ReadOff(const std::string& path) {
-  std::istringstream in(ReadBytes(path));
+  const std::string bytes = ReadBytes(path);
+  std::istringstream in(bytes);
   std::string line;
   int line_no = 0;
   // Lines without comments and blanks, as token lists.
@@ -122,8 +129,13 @@ TriangleMesh ReadOff(const std::string& path) {
   t.erase(t.begin());
   if (t.empty() && !next(&t)) throw InputError(path, "missing vertex/face counts");
   if (t.size() < 2) throw InputError(path, "line " + std::to_string(line_no) + ": expected vertex and face counts");
-  const double nv = ParseNumber(t[0], path, line_no), nf = ParseNumber(t[1], path, line_no);
-  if (nv < 0 || nf < 0 || nv > 1e9 || nf > 1e9) throw InputError(path, "bad vertex/face counts");
+  const long long nv = ParseIndex(t[0], 1e9, path, line_no, "vertex count");
+  const long long nf = ParseIndex(t[1], 1e9, path, line_no, "face count");
+  // A vertex line takes at least 6 bytes ("0 0 0\n") and a face line 8 ("3 0 1 2\n"): counts the file
+  // cannot hold are refused before anything is reserved from them.
+  if (6.0 * static_cast<double>(nv) + 8.0 * static_cast<double>(nf) > static_cast<double>(bytes.size()))
+    throw InputError(path, "declares " + std::to_string(nv) + " vertices and " + std::to_string(nf) +
+                               " faces, more than its " + std::to_string(bytes.size()) + " bytes can hold (truncated?)");
   TriangleMesh mesh;
   mesh.vertices.reserve(static_cast<size_t>(nv));
   for (size_t i = 0; i < static_cast<size_t>(nv); ++i) {
@@ -134,12 +146,12 @@ TriangleMesh ReadOff(const std::string& path) {
   }
   for (size_t f = 0; f < static_cast<size_t>(nf); ++f) {
     if (!next(&t)) throw InputError(path, "file ends after " + std::to_string(f) + " of " + std::to_string(static_cast<size_t>(nf)) + " faces (truncated?)");
-    const double k = ParseNumber(t[0], path, line_no);
-    if (k < 0 || t.size() < static_cast<size_t>(k) + 1)
+    const long long k = ParseIndex(t[0], 1e6, path, line_no, "face size");
+    if (t.size() < static_cast<size_t>(k) + 1)
       throw InputError(path, "line " + std::to_string(line_no) + ": face has fewer indices than its count");
     std::vector<long long> poly;
     for (size_t j = 1; j <= static_cast<size_t>(k); ++j)
-      poly.push_back(static_cast<long long>(ParseNumber(t[j], path, line_no)));
+      poly.push_back(ParseIndex(t[j], static_cast<double>(mesh.vertices.size()), path, line_no, "vertex index"));
     AddPolygon(mesh, poly, mesh.vertices.size(), path, "line " + std::to_string(line_no));
   }
   return mesh;
@@ -189,14 +201,18 @@ TriangleMesh ReadStl(const std::string& path) {
   if (bytes.compare(0, 5, "solid") != 0)
     throw InputError(path, "not an STL file (neither ASCII 'solid' nor a binary size of 84 + 50 * triangles bytes)");
   std::istringstream in(bytes);
-  std::string word;
+  std::string line;
   std::vector<int> corners;
-  while (in >> word) {
-    if (word != "vertex") continue;
-    std::string a, b, c;
-    if (!(in >> a >> b >> c)) throw InputError(path, "ASCII STL ends inside a vertex (truncated?)");
-    const std::array<float, 3> p{static_cast<float>(ParseNumber(a, path, 0)), static_cast<float>(ParseNumber(b, path, 0)),
-                                 static_cast<float>(ParseNumber(c, path, 0))};
+  int line_no = 0;
+  while (std::getline(in, line)) {
+    ++line_no;
+    std::istringstream words(line);
+    std::string word, a, b, c;
+    if (!(words >> word) || word != "vertex") continue;
+    if (!(words >> a >> b >> c)) throw InputError(path, "line " + std::to_string(line_no) + ": 'vertex' needs x y z");
+    const std::array<float, 3> p{static_cast<float>(ParseNumber(a, path, line_no)),
+                                 static_cast<float>(ParseNumber(b, path, line_no)),
+                                 static_cast<float>(ParseNumber(c, path, line_no))};
     corners.push_back(welder.Add(mesh, p));
   }
   if (corners.size() % 3 != 0) throw InputError(path, "ASCII STL has a facet without 3 vertices (truncated?)");
@@ -206,8 +222,9 @@ TriangleMesh ReadStl(const std::string& path) {
 
 }  // namespace
 
-TriangleMesh ReadMeshPly(const std::string& path) {
-  const ply::File file = ply::Read(path);
+TriangleMesh ReadMeshPly(const std::string& file_path) {
+  const ply::File file = ply::Read(file_path);
+  const std::string path = InputName(file_path);
   CheckDeclaredKind(file, path, "mesh", kMeshFormatVersion);
   const ply::Element& v = RequireElement(file, path, "vertex", "mesh");
   const auto& x = RequireScalar(v, path, "x");
@@ -234,7 +251,7 @@ TriangleMesh ReadMeshPly(const std::string& path) {
 TriangleMesh ReadMesh(const std::string& path) {
   const std::string ext = LowerExtension(path);
   TriangleMesh mesh;
-  if (ext == "ply") mesh = ReadMeshPly(path);
+  if (ext == "ply" || path == "-") mesh = ReadMeshPly(path);  // a stream is a pipeline mesh: PLY
   else if (ext == "obj") mesh = ReadObj(path);
   else if (ext == "off") mesh = ReadOff(path);
   else if (ext == "stl") mesh = ReadStl(path);

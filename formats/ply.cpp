@@ -11,6 +11,7 @@
 #include <sstream>
 
 #include "common/atomic_file.h"
+#include "common/input_file.h"
 #include "common/errors.h"
 
 namespace voroudf::ply {
@@ -149,6 +150,40 @@ class BodyReader {
   bool swap_;
 };
 
+// A comment is one header line: control characters (a newline in a --udf path, say) would end it and
+// let the rest be read as header keywords, so they are written as \xNN.
+std::string EscapeComment(const std::string& c) {
+  std::string out;
+  for (unsigned char ch : c) {
+    if (ch >= 0x20 && ch != 0x7f) {
+      out += static_cast<char>(ch);
+    } else {
+      char buf[8];
+      std::snprintf(buf, sizeof buf, "\\x%02x", ch);
+      out += buf;
+    }
+  }
+  return out;
+}
+
+// Every value must survive its declared type: finite, and for float32 within its range (a double beyond
+// FLT_MAX would be written as inf). NumericalError (exit 4): the numbers, not the input, went wrong.
+void CheckRepresentable(const File& file, const std::string& path) {
+  for (const auto& e : file.elements)
+    for (const auto& p : e.properties) {
+      if (IsIntegral(p.type)) continue;
+      const double limit = p.type == Type::kFloat32 ? std::numeric_limits<float>::max() : std::numeric_limits<double>::max();
+      for (size_t k = 0; k < p.values.size(); ++k)
+        if (!(std::abs(p.values[k]) <= limit)) {
+          char value[40];
+          std::snprintf(value, sizeof value, "%g", p.values[k]);
+          throw NumericalError(path + ": element '" + e.name + "' property '" + p.name + "' value " +
+                               std::to_string(k) + " is " + value + ", not a finite " + TypeName(p.type) +
+                               ": nothing written");
+        }
+    }
+}
+
 }  // namespace
 
 const char* TypeName(Type type) {
@@ -197,11 +232,12 @@ const Element* File::Find(const std::string& element) const {
 }
 
 File Read(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path, std::string("cannot open: ") + std::strerror(errno));
-  std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  if (in.bad()) throw InputError(path, "read error");
-  return Parse(bytes, path);
+  const std::string name = path == "-" ? "stdin" : path;
+  const std::string bytes = ReadInputBytes(path, [&](const std::string& head) {
+    if (head.compare(0, 4, "ply\n") != 0 && head.compare(0, 5, "ply\r\n") != 0)
+      throw InputError(name, "not a PLY file (first line is not 'ply')");
+  });
+  return Parse(bytes, name);
 }
 
 File Parse(const std::string& bytes, const std::string& name) {
@@ -283,6 +319,18 @@ File Parse(const std::string& bytes, const std::string& name) {
   if (!have_format) throw InputError(name, "PLY header has no 'format' line");
 
   BodyReader body(bytes, pos, name, file.encoding);
+  // Nothing is reserved from a declared count the file cannot hold. An ASCII value takes at least two
+  // bytes (a digit and a separator; the last may end the file), so an ASCII body of more values than half
+  // its bytes is truncated whatever it says.
+  if (file.encoding == Encoding::kAscii) {
+    long double values = 0;
+    for (const auto& e : file.elements)
+      values += static_cast<long double>(e.properties.size()) * static_cast<long double>(e.count);
+    if (values > static_cast<long double>(body.Remaining() + 1) / 2)
+      throw InputError(name, "file is shorter than its header promises (" +
+                                 std::to_string(static_cast<unsigned long long>(values)) + " values declared, " +
+                                 std::to_string(body.Remaining()) + " bytes of ASCII data): truncated file?");
+  }
   // A binary body of fixed-size items can be checked against the file size before anything is allocated.
   if (file.encoding != Encoding::kAscii) {
     long double need = 0;
@@ -333,7 +381,7 @@ std::string Serialize(const File& file) {
                                                            ? "binary_little_endian"
                                                            : "binary_big_endian";
   out += " 1.0\n";
-  for (const auto& c : file.comments) out += "comment " + c + "\n";
+  for (const auto& c : file.comments) out += "comment " + EscapeComment(c) + "\n";
   size_t body_bytes = 0;
   for (const auto& e : file.elements) {
     out += "element " + e.name + " " + std::to_string(e.count) + "\n";
@@ -379,6 +427,9 @@ std::string Serialize(const File& file) {
   return out;
 }
 
-void Write(const std::string& path, const File& file) { WriteFileAtomically(path, Serialize(file)); }
+void Write(const std::string& path, const File& file) {
+  CheckRepresentable(file, path);
+  WriteFileAtomically(path, Serialize(file));
+}
 
 }  // namespace voroudf::ply

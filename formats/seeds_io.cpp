@@ -1,6 +1,7 @@
 #include "formats/seeds_io.h"
 
 #include "common/errors.h"
+#include "common/input_file.h"
 #include "formats/kinds.h"
 
 namespace voroudf {
@@ -12,8 +13,9 @@ void SeedCloud::Resize(size_t n) {
   rank.resize(n, kRankUnknown);
 }
 
-SeedCloud ReadSeeds(const std::string& path) {
-  const ply::File file = ply::Read(path);
+SeedCloud ReadSeeds(const std::string& file_path) {
+  const ply::File file = ply::Read(file_path);
+  const std::string path = InputName(file_path);
   CheckDeclaredKind(file, path, "seeds", kSeedsFormatVersion);
   if (FindDeclaredKind(file).kind.empty()) {
     const ply::Element* faces = file.Find("face");

@@ -1,6 +1,8 @@
 // Formats: round trips, files from other tools, and every kind of bad file refused with a clear error.
 #include <gtest/gtest.h>
 
+#include <functional>
+
 #include <cmath>
 #include <cstring>
 
@@ -103,8 +105,11 @@ TEST_P(RoundTrip, LabelsWithGraph) {
   const LabeledSamples back = ReadLabels(dir / "l.ply");
   EXPECT_EQ(back.position, s.position);
   EXPECT_EQ(back.label, s.label);
-  EXPECT_EQ(back.dist, s.dist);
+  EXPECT_EQ(back.dist, (std::vector<double>{0.0, -1.0, 0.5})) << "an unreached sample's distance is written as -1";
   EXPECT_EQ(back.edges, s.edges);
+  s.dist[1] = INFINITY;  // what the sweep leaves on an unreached sample: still a readable file
+  WriteLabels(dir / "l.ply", s, TestProvenance(), ascii);
+  EXPECT_EQ(ReadLabels(dir / "l.ply").dist[1], -1.0);
 }
 
 INSTANTIATE_TEST_SUITE_P(BinaryAndAscii, RoundTrip, ::testing::Values(false, true));
@@ -247,10 +252,50 @@ TEST_F(BadFiles, FutureVersion) {
 }
 
 TEST_F(BadFiles, NaNCoordinate) {
-  SeedCloud s = RandomSeeds(5);
-  s.position[3].y() = std::nan("");
-  WriteSeeds(Path("n.ply"), s, TestProvenance());
-  ExpectInputError([&] { ReadSeeds(Path("n.ply")); }, "item 3 property 'y' is not finite");
+  WriteBytes(Path("n.ply"), "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\n"
+                            "property float z\nend_header\n0 0 0\n1 nan 0\n");
+  ExpectInputError([&] { ReadSeeds(Path("n.ply")); }, "item 1 property 'y' is not finite");
+}
+
+TEST(FiniteOutput, EveryWriterRefusesNonFiniteOrUnrepresentableValuesAndWritesNothing) {
+  TempDir dir;
+  auto expect_refused = [&](const std::function<void(const std::string&)>& write, const char* what) {
+    try {
+      write(dir / "out.ply");
+      ADD_FAILURE() << what << ": written";
+    } catch (const NumericalError& e) {
+      EXPECT_NE(std::string(e.what()).find("nothing written"), std::string::npos) << e.what();
+    }
+    EXPECT_FALSE(test::Exists(dir / "out.ply")) << what;
+    EXPECT_EQ(dir.List().size(), 0u) << what << ": no temporary file left";
+  };
+  for (double bad : {std::nan(""), double(INFINITY), -double(INFINITY), 1e300}) {
+    SeedCloud seeds = RandomSeeds(4);
+    seeds.position[2].x() = bad;
+    expect_refused([&](const std::string& p) { WriteSeeds(p, seeds, TestProvenance()); }, "seed position");
+    seeds = RandomSeeds(4);
+    seeds.udf[1] = bad;
+    expect_refused([&](const std::string& p) { WriteSeeds(p, seeds, TestProvenance(), true); }, "seed udf");
+    TriangleMesh mesh = NonManifoldMesh();
+    mesh.vertices[0].z() = bad;
+    expect_refused([&](const std::string& p) { WriteMeshPly(p, mesh, TestProvenance()); }, "mesh vertex");
+    LabeledSamples labels;
+    labels.position = {Vec3(0, 0, 0), Vec3(bad, 0, 0)};
+    labels.label = {0, 0};
+    labels.dist = {0, 0};
+    expect_refused([&](const std::string& p) { WriteLabels(p, labels, TestProvenance()); }, "label position");
+  }
+}
+
+TEST(Header, CommentsEscapeControlCharactersSoTheHeaderStaysWhole) {
+  TempDir dir;
+  const Provenance provenance{"test", "--x 1", "shape:sphere\nelement vertex 99\rend_header\x01"};
+  WriteSeeds(dir / "s.ply", RandomSeeds(3), provenance);
+  const SeedCloud back = ReadSeeds(dir / "s.ply");
+  EXPECT_EQ(back.size(), 3u);
+  const std::string bytes = test::ReadBytes(dir / "s.ply");
+  EXPECT_NE(bytes.find("comment udf shape:sphere\\x0aelement vertex 99\\x0dend_header\\x01\n"), std::string::npos)
+      << bytes.substr(0, 300);
 }
 
 TEST_F(BadFiles, FaceIndexOutOfRange) {

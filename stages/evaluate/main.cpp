@@ -18,7 +18,7 @@ int main(int argc, char** argv) {
                         "reference's normalised frame, sampled (the paper's protocol) and exact (samples to the "
                         "other mesh's triangles); prints one line of JSON, or writes it to -o.");
   cli.AddInput(&input, "mesh under test (.ply, .obj, .off or .stl)");
-  cli.app().add_option("--reference", reference, "reference mesh (.ply, .obj, .off or .stl)")->required();
+  cli.AddExtraInput("--reference", &reference, "reference mesh (.ply, .obj, .off or .stl; - for a PLY on stdin)")->required();
   cli.AddExtraOutput("-o,--output", &output, "write the JSON here (atomically) instead of stdout");
   cli.AddSeed(&options.seed);
   auto& app = cli.app();
