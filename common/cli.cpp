@@ -182,7 +182,7 @@ int StageCli::Run(int argc, char** argv, const std::function<void()>& check,
                   const std::function<void(Monitor&)>& body) {
   for (CLI::Option* opt : app_.get_options()) {
     const std::string type = opt->get_type_name().substr(0, opt->get_type_name().find(':'));
-    if (type == "UINT" || type == "INT" || type == "FLOAT") opt->check(NumberCheck(type));
+    if (type == "UINT" || type == "INT" || type == "FLOAT") opt->transform(NumberCheck(type));  // may rewrite
   }
   try {
     app_.parse(argc, argv);

@@ -7,6 +7,7 @@
 #include <pthread.h>
 #include <signal.h>
 #include <spawn.h>
+#include <sys/prctl.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -89,6 +90,10 @@ ExecUdf::ExecUdf(const std::string& command, const ExecUdfOptions& options) : co
     close(in_pipe[0]), close(in_pipe[1]);
     throw InputError("exec:" + command_, std::string("pipe: ") + std::strerror(errno));
   }
+  // Orphans of the server (children it forked, then died) come back to us rather than to init, so that
+  // ending its group can reap them: an init that never reaps (as in some containers) would otherwise
+  // leave zombies that still count as members of the group.
+  prctl(PR_SET_CHILD_SUBREAPER, 1);
   posix_spawn_file_actions_t actions;
   posix_spawn_file_actions_init(&actions);
   posix_spawn_file_actions_adddup2(&actions, in_pipe[0], 0);

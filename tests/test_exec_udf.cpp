@@ -5,7 +5,11 @@
 #include <omp.h>
 #include <signal.h>
 
+#include <sys/wait.h>
+
 #include <chrono>
+#include <fstream>
+#include <sstream>
 #include <cmath>
 #include <thread>
 
@@ -193,6 +197,103 @@ TEST_F(FakeServers, SampleSeedsEndsWithExitThreeWithinTheTimeoutAndNoOutput) {
     // One line: "sample-seeds: error: exec:...: ...".
     EXPECT_NE(r.err.find("sample-seeds: error: exec:"), std::string::npos) << r.err;
   }
+}
+
+// A server that ignores SIGTERM and forks a child that does too; both write their pids to `pid_file`.
+std::string StubbornServer(const std::string& body) {
+  return FakeServer("import os, signal\n"
+                    "signal.signal(signal.SIGTERM, signal.SIG_IGN)\n"
+                    "child = os.fork()\n"
+                    "if child == 0:\n"
+                    "    time.sleep(600)\n"
+                    "    os._exit(0)\n"
+                    "open(sys.argv[1] + '.tmp', 'w').write('%d %d' % (os.getpid(), child))\n"
+                    "os.rename(sys.argv[1] + '.tmp', sys.argv[1])\n" + body);
+}
+
+// Alive and not a zombie (a zombie is gone for every purpose but its process table entry).
+bool Alive(pid_t pid) {
+  std::ifstream stat("/proc/" + std::to_string(pid) + "/stat");
+  std::string line;
+  if (!std::getline(stat, line)) return false;
+  const auto paren = line.rfind(')');
+  return paren != std::string::npos && paren + 2 < line.size() && line[paren + 2] != 'Z';
+}
+
+std::vector<pid_t> WaitForPids(const std::string& pid_file) {
+  for (int i = 0; i < 1000 && !test::Exists(pid_file); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  std::istringstream in(test::ReadBytes(pid_file));
+  pid_t a = 0, b = 0;
+  in >> a >> b;
+  return {a, b};
+}
+
+bool AllGoneWithin(const std::vector<pid_t>& pids, double seconds) {
+  const auto start = Clock::now();
+  while (Seconds(start) < seconds) {
+    bool any = false;
+    for (pid_t p : pids) any = any || Alive(p);
+    if (!any) return true;
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  return false;
+}
+
+TEST_F(FakeServers, AServerThatIgnoresSigtermAndForksIsEndedWithItsChild) {
+  // The first ignores both EOF and SIGTERM: only SIGKILL to its whole group ends it. The second exits at
+  // EOF, as it should, but leaves its child behind: the group is ended although the server is gone.
+  for (const char* body : {"time.sleep(600)\n", "sys.stdin.buffer.read()\nsys.exit(0)\n"}) {
+    const std::string pid_file = dir_ / (std::string("pids") + (body[0] == 't' ? "1" : "2"));
+    const std::string cmd = Script("stubborn.py", StubbornServer(body)) + " " + pid_file;
+    std::vector<pid_t> pids;
+    {
+      ExecUdf udf(cmd, {});
+      pids = WaitForPids(pid_file);
+      ASSERT_GT(pids[0], 0);
+      ASSERT_GT(pids[1], 0);
+      EXPECT_TRUE(Alive(pids[0]) && Alive(pids[1]));
+    }
+    EXPECT_TRUE(AllGoneWithin(pids, 1.0)) << body << ": server " << pids[0] << " or its child " << pids[1]
+                                          << " is still running";
+  }
+}
+
+TEST_F(FakeServers, ASignalToTheStageEndsTheServersGroup) {
+  for (int sig : {SIGTERM, SIGINT, SIGHUP}) {
+    const std::string pid_file = dir_ / ("pids" + std::to_string(sig));
+    const std::string server = Script("stubborn.py", StubbornServer("time.sleep(600)\n")) + " " + pid_file;
+    const pid_t stage = fork();
+    ASSERT_GE(stage, 0);
+    if (stage == 0) {
+      const std::string exe = std::string(VOROUDF_BIN_DIR) + "/sample-seeds";
+      execl(exe.c_str(), "sample-seeds", "--udf", ("exec:" + server).c_str(), "--count", "100", "-q", "-o",
+            (dir_ / "s.ply").c_str(), static_cast<char*>(nullptr));
+      _exit(127);
+    }
+    const std::vector<pid_t> pids = WaitForPids(pid_file);
+    ASSERT_GT(pids[1], 0);
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));  // the stage now waits for an answer
+    kill(stage, sig);
+    int status = 0;
+    waitpid(stage, &status, 0);
+    EXPECT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == sig) << status;
+    EXPECT_TRUE(AllGoneWithin(pids, 1.0)) << "signal " << sig << ": server or child still running";
+    EXPECT_FALSE(test::Exists(dir_ / "s.ply"));
+  }
+  EXPECT_EQ(test::ReadBytes(dir_ / "stubborn.py").empty(), false);
+}
+
+TEST_F(FakeServers, AnErrorInsideTheStageEndsTheServersGroup) {
+  // The server answers garbage to the first request; it and its child must not outlive the stage.
+  const std::string server = Script("garbage_stubborn.py", StubbornServer("n = struct.unpack('<I', sys.stdin.buffer.read(4))[0]\n"
+                                                                          "sys.stdin.buffer.read(12 * n)\n"
+                                                                          "sys.stdout.buffer.write(b'x' * 64)\n"
+                                                                          "sys.stdout.flush()\n"
+                                                                          "time.sleep(600)\n")) +
+                             " " + dir_ / "gpids";
+  const auto r = RunProgram("sample-seeds", {"--udf", "exec:" + server, "--count", "100", "-o", dir_ / "s.ply"});
+  EXPECT_EQ(r.exit_code, 3) << r.err;
+  EXPECT_TRUE(AllGoneWithin(WaitForPids(dir_ / "gpids"), 1.0));
 }
 
 TEST(ExecUdfExe, ReferenceServerGivesTheSameSeedsAsTheBuiltInSphere) {
