@@ -258,6 +258,12 @@ TEST(Executables, TwoOutputsArePublishedTogetherOrNotAtAll) {
     EXPECT_NE(LastLine(same.err).find("name the same output file"), std::string::npos) << same.err;
   }
   EXPECT_EQ(dir.List(), std::vector<std::string>{"s.ply"});
+  // A full disk on the second output (/dev/full takes no byte): the first is not published either.
+  const auto full = RunProgram("build-gvd", {"--udf", "shape:sphere", "-i", dir / "s.ply", "-o", dir / "thick.ply",
+                                             "--labels", "/dev/full"});
+  EXPECT_EQ(full.exit_code, 1) << full.err;
+  EXPECT_NE(LastLine(full.err).find("/dev/full: write failed"), std::string::npos) << full.err;
+  EXPECT_EQ(dir.List(), std::vector<std::string>{"s.ply"});
 }
 
 TEST(Executables, ASignalWhileWritingLeavesNeitherOutput) {
