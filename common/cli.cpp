@@ -43,7 +43,7 @@ CLI::Validator NumberCheck(const std::string& type) {
         errno = 0;
         if (type == "FLOAT") {
           const double v = std::strtod(s, &end);
-          if (end == s || *end != '\0') return "'" + text + "' is not a number";
+          if (end == s || end != s + text.size()) return "'" + text + "' is not a number";
           if (!std::isfinite(v) || (errno == ERANGE && std::abs(v) > 1)) return "'" + text + "' is not a finite number";
           return "";
         }

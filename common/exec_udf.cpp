@@ -21,6 +21,7 @@
 
 #include "common/cleanup.h"
 #include "common/errors.h"
+#include "common/exec_protocol.h"
 #include "common/udf_spec.h"
 
 extern char** environ;
@@ -29,21 +30,6 @@ namespace voroudf {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-std::string Printable(const char* data, size_t n) {
-  std::string s;
-  for (size_t i = 0; i < n; ++i) {
-    const unsigned char c = static_cast<unsigned char>(data[i]);
-    if (c >= 32 && c < 127) {
-      s += static_cast<char>(c);
-    } else {
-      char buf[8];
-      std::snprintf(buf, sizeof buf, "\\x%02x", c);
-      s += buf;
-    }
-  }
-  return s;
-}
 
 std::string DescribeStatus(int status) {
   if (WIFEXITED(status)) return "exited with status " + std::to_string(WEXITSTATUS(status));
@@ -71,13 +57,6 @@ ssize_t WriteNoSigpipe(int fd, const char* data, size_t n) {
   pthread_sigmask(SIG_SETMASK, &old_mask, nullptr);
   errno = saved;
   return r;
-}
-
-void PutU32(std::string& s, uint32_t v) { s.append(reinterpret_cast<const char*>(&v), 4); }
-uint32_t GetU32(const char* p) {
-  uint32_t v;
-  std::memcpy(&v, p, 4);
-  return v;
 }
 
 }  // namespace
@@ -132,26 +111,18 @@ ExecUdf::ExecUdf(const std::string& command, const ExecUdfOptions& options) : co
   fcntl(from_child_, F_SETFL, fcntl(from_child_, F_GETFL) | O_NONBLOCK);
 
   // Handshake: "VUDF", uint32 version, 6 float32 box, uint32 name length, name.
-  char head[36];
+  char head[protocol::kHelloBytes];
   Exchange("", head, sizeof head, "the handshake");
-  if (std::memcmp(head, "VUDF", 4) != 0)
-    Fail("not a voroudf UDF server: its output starts with '" + Printable(head, 4) +
-         "', expected the magic 'VUDF' (docs/exec-protocol.md)");
-  const uint32_t version = GetU32(head + 4);
-  if (version != kVersion)
-    Fail("the server speaks protocol version " + std::to_string(version) + ", this program knows version " +
-         std::to_string(kVersion));
-  float box[6];
-  std::memcpy(box, head + 8, sizeof box);
-  for (float b : box)
-    if (!std::isfinite(b)) Fail("the handshake's domain box has a non-finite number");
-  domain_ = Box{Vec3(box[0], box[1], box[2]), Vec3(box[3], box[4], box[5])};
-  if (!(domain_.min.array() < domain_.max.array()).all()) Fail("the handshake's domain box is empty (min >= max)");
-  const uint32_t name_len = GetU32(head + 32);
-  if (name_len > 4096) Fail("the handshake's server name is " + std::to_string(name_len) + " bytes long (at most 4096)");
-  server_name_.resize(name_len);
-  if (name_len > 0) Exchange("", server_name_.data(), name_len, "the handshake's server name");
-  server_name_ = Printable(server_name_.data(), server_name_.size());
+  protocol::Hello hello;
+  try {
+    hello = protocol::ParseHello(head);
+  } catch (const protocol::ProtocolError& e) {
+    Fail(e.what());
+  }
+  domain_ = hello.domain;
+  server_name_.resize(hello.name_length);
+  if (hello.name_length > 0) Exchange("", server_name_.data(), hello.name_length, "the handshake's server name");
+  server_name_ = protocol::Printable(server_name_.data(), server_name_.size());
 }
 
 ExecUdf::~ExecUdf() {
@@ -247,33 +218,17 @@ void ExecUdf::Exchange(const std::string& out, char* in, size_t in_len, const st
 
 void ExecUdf::Query(const Vec3* points, size_t count, double* distance, Vec3* gradient) const {
   if (!failure_.empty()) throw InputError(failure_);
-  std::string request;
-  request.reserve(4 + 12 * count);
-  PutU32(request, static_cast<uint32_t>(count));
-  for (size_t i = 0; i < count; ++i) {
-    const float xyz[3] = {static_cast<float>(points[i].x()), static_cast<float>(points[i].y()),
-                          static_cast<float>(points[i].z())};
-    request.append(reinterpret_cast<const char*>(xyz), sizeof xyz);
-  }
-  std::vector<char> answer(4 + 16 * count);
+  const std::string request = protocol::EncodeRequest(points, count);
+  std::vector<char> answer(4 + protocol::AnswerBodyBytes(count));
   const std::string what = "the answer to a request of " + std::to_string(count) + " points";
-  // The count first: a server answering another count is caught before we wait for bytes that never come.
-  Exchange(request, answer.data(), 4, what);
-  const uint32_t echoed = GetU32(answer.data());
-  if (echoed != count)
-    Fail("answered " + std::to_string(echoed) + " values to a request of " + std::to_string(count) +
-         " points (wrong count or garbage)");
-  Exchange("", answer.data() + 4, 16 * count, what);
-  const float* d = reinterpret_cast<const float*>(answer.data() + 4);
-  const float* g = d + count;
-  for (size_t i = 0; i < count; ++i) {
-    const Vec3 gi(g[3 * i], g[3 * i + 1], g[3 * i + 2]);
-    if (!std::isfinite(d[i]) || !gi.allFinite())
-      Fail("answered a non-finite distance or gradient for point " + std::to_string(answered_ + i) + " (garbage?)");
-    // Learned fields dip slightly below zero; the UDF is max(d, 0).
-    distance[i] = std::max(0.0, static_cast<double>(d[i]));
-    const double len = gi.norm();
-    gradient[i] = len > 0.0 ? Vec3(gi / len) : Vec3::Zero();
+  try {
+    // The count first: a server answering another count is caught before we wait for bytes that never come.
+    Exchange(request, answer.data(), 4, what);
+    protocol::CheckAnswerCount(answer.data(), count);
+    Exchange("", answer.data() + 4, protocol::AnswerBodyBytes(count), what);
+    protocol::DecodeAnswer(answer.data() + 4, count, answered_, distance, gradient);
+  } catch (const protocol::ProtocolError& e) {
+    Fail(e.what());
   }
   answered_ += count;
 }

@@ -35,8 +35,8 @@ struct ExecUdfOptions {
 /// Precision: the protocol carries float32, so distances and positions are good to ~1e-7 relative.
 class ExecUdf : public Udf {
  public:
-  static constexpr uint32_t kVersion = 1;
-  static constexpr uint32_t kMaxRequest = 1u << 20;
+  static constexpr uint32_t kVersion = 1;             ///< protocol::kVersion
+  static constexpr uint32_t kMaxRequest = 1u << 20;   ///< protocol::kMaxRequest
 
   /// \param command what follows "exec:" in the SPEC, run by /bin/sh -c
   /// Throws InputError if the process cannot start or its handshake is missing, late or malformed.

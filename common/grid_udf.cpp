@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <cstring>
 #include <fstream>
 #include <sstream>
@@ -231,7 +232,7 @@ Box ParseBoxOption(const std::string& text) {
   while (std::getline(in, item, ',')) {
     char* end = nullptr;
     const double x = std::strtod(item.c_str(), &end);
-    if (item.empty() || end == item.c_str() || *end != '\0' || !std::isfinite(x))
+    if (item.empty() || end == item.c_str() || end != item.c_str() + item.size() || !std::isfinite(x))
       throw UsageError("--udf-box '" + text + "': expected six numbers xmin,ymin,zmin,xmax,ymax,zmax");
     v.push_back(x);
   }
@@ -296,10 +297,20 @@ GridUdf::GridUdf(const std::vector<float>& values, std::array<size_t, 3> dims, c
   if (!gradient_.empty() && gradient_.size() != 3 * count)
     throw InputError(name_, "gradient array has " + std::to_string(gradient_.size()) + " values, expected 3 * " + std::to_string(count));
   if (!(box_.min.array() < box_.max.array()).all()) throw InputError(name_, "the grid's box is empty");
+  if (!std::isfinite(box_.Diagonal())) throw InputError(name_, "the grid's box is too large (its diagonal overflows)");
   q_.resize(count);
+  // A distance sampled in the box is at most its diagonal where the surface lies in it; a million times
+  // that is no distance at all, and its square (kept as float) would overflow the interpolation.
+  const double largest = std::min(1e6 * box_.Diagonal(), 1e15);
   for (size_t i = 0; i < count; ++i) {
     if (!std::isfinite(values[i])) throw InputError(name_, "sample " + std::to_string(i) + " is not finite");
     const double d = std::max(0.0, static_cast<double>(values[i]));
+    if (d > largest) {
+      char buf[120];
+      std::snprintf(buf, sizeof buf, "sample %zu is %g, more than a million box diagonals (%g): not a distance", i,
+                    d, box_.Diagonal());
+      throw InputError(name_, buf);
+    }
     q_[i] = static_cast<float>(d * d);
   }
   for (float g : gradient_)

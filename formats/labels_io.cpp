@@ -3,12 +3,13 @@
 #include "common/errors.h"
 #include "common/input_file.h"
 #include "formats/kinds.h"
+#include "formats/ply.h"
 
 namespace voroudf {
 
-LabeledSamples ReadLabels(const std::string& file_path) {
-  const ply::File file = ply::Read(file_path);
-  const std::string path = InputName(file_path);
+LabeledSamples ReadLabels(const std::string& path) { return LabelsFromPly(ply::Read(path), InputName(path)); }
+
+LabeledSamples LabelsFromPly(const ply::File& file, const std::string& path) {
   CheckDeclaredKind(file, path, "labels", kLabelsFormatVersion);
   const ply::Element& v = RequireElement(file, path, "vertex", "labels");
   const auto& x = RequireScalar(v, path, "x");

@@ -8,6 +8,7 @@
 
 #include "common/provenance.h"
 #include "common/types.h"
+#include "formats/ply.h"
 
 namespace voroudf {
 
@@ -20,7 +21,10 @@ struct LabeledSamples {
   size_t size() const { return position.size(); }
 };
 
+/// Reads a labels file. Throws InputError (exit 3) for anything malformed.
 LabeledSamples ReadLabels(const std::string& path);
+/// The same from a PLY file already parsed; `name` names it in messages.
+LabeledSamples LabelsFromPly(const ply::File& file, const std::string& name);
 void WriteLabels(const std::string& path, const LabeledSamples& samples, const Provenance& provenance,
                  bool ascii = false);
 

@@ -25,7 +25,6 @@ std::string LowerExtension(const std::string& path) {
   return ext;
 }
 
-std::string ReadBytes(const std::string& path) { return ReadInputBytes(path); }
 
 // Appends polygon `poly` as a triangle fan after checking its indices.
 void AddPolygon(TriangleMesh& mesh, const std::vector<long long>& poly, size_t num_vertices, const std::string& path,
@@ -49,13 +48,13 @@ void CheckFiniteVertices(const TriangleMesh& mesh, const std::string& path) {
 double ParseNumber(const std::string& token, const std::string& path, int line) {
   char* end = nullptr;
   const double v = std::strtod(token.c_str(), &end);
-  if (end == token.c_str() || *end != '\0')
+  if (end == token.c_str() || end != token.c_str() + token.size())
     throw InputError(path, "line " + std::to_string(line) + ": '" + token + "' is not a number");
   return v;
 }
 
-TriangleMesh ReadObj(const std::string& path) {
-  std::istringstream in(ReadBytes(path));
+TriangleMesh ParseObj(const std::string& bytes, const std::string& path) {
+  std::istringstream in(bytes);
   TriangleMesh mesh;
   std::vector<std::vector<long long>> faces;
   std::vector<int> face_lines;
@@ -79,7 +78,7 @@ TriangleMesh ReadObj(const std::string& path) {
         const std::string first = token.substr(0, token.find('/'));
         char* end = nullptr;
         const long long idx = std::strtoll(first.c_str(), &end, 10);
-        if (first.empty() || *end != '\0' || idx == 0)
+        if (first.empty() || end != first.c_str() + first.size() || idx == 0)
           throw InputError(path, "line " + std::to_string(line_no) + ": bad face index '" + token + "'");
         poly.push_back(idx > 0 ? idx - 1 : static_cast<long long>(mesh.vertices.size()) + idx);
       }
@@ -101,8 +100,7 @@ long long ParseIndex(const std::string& token, double limit, const std::string& 
   return static_cast<long long>(v);
 }
 
-TriangleMesh ReadOff(const std::string& path) {
-  const std::string bytes = ReadBytes(path);
+TriangleMesh ParseOff(const std::string& bytes, const std::string& path) {
   std::istringstream in(bytes);
   std::string line;
   int line_no = 0;
@@ -175,8 +173,7 @@ struct VertexWelder {
   }
 };
 
-TriangleMesh ReadStl(const std::string& path) {
-  const std::string bytes = ReadBytes(path);
+TriangleMesh ParseStl(const std::string& bytes, const std::string& path) {
   TriangleMesh mesh;
   VertexWelder welder;
   uint32_t n = 0;
@@ -222,9 +219,9 @@ TriangleMesh ReadStl(const std::string& path) {
 
 }  // namespace
 
-TriangleMesh ReadMeshPly(const std::string& file_path) {
-  const ply::File file = ply::Read(file_path);
-  const std::string path = InputName(file_path);
+TriangleMesh ReadMeshPly(const std::string& path) { return MeshFromPly(ply::Read(path), InputName(path)); }
+
+TriangleMesh MeshFromPly(const ply::File& file, const std::string& path) {
   CheckDeclaredKind(file, path, "mesh", kMeshFormatVersion);
   const ply::Element& v = RequireElement(file, path, "vertex", "mesh");
   const auto& x = RequireScalar(v, path, "x");
@@ -249,14 +246,26 @@ TriangleMesh ReadMeshPly(const std::string& file_path) {
 }
 
 TriangleMesh ReadMesh(const std::string& path) {
+  if (path == "-") return ParseMesh(ReadInputBytes(path), "ply", InputName(path));  // a stream is a pipeline mesh
   const std::string ext = LowerExtension(path);
+  if (ext == "ply") {
+    TriangleMesh mesh = ReadMeshPly(path);
+    CheckFiniteVertices(mesh, path);
+    return mesh;
+  }
+  if (ext != "obj" && ext != "off" && ext != "stl")
+    throw InputError(path, "unknown mesh file extension (expected .ply, .obj, .off or .stl)");
+  return ParseMesh(ReadInputBytes(path), ext, path);
+}
+
+TriangleMesh ParseMesh(const std::string& bytes, const std::string& format, const std::string& name) {
   TriangleMesh mesh;
-  if (ext == "ply" || path == "-") mesh = ReadMeshPly(path);  // a stream is a pipeline mesh: PLY
-  else if (ext == "obj") mesh = ReadObj(path);
-  else if (ext == "off") mesh = ReadOff(path);
-  else if (ext == "stl") mesh = ReadStl(path);
-  else throw InputError(path, "unknown mesh file extension (expected .ply, .obj, .off or .stl)");
-  CheckFiniteVertices(mesh, path);
+  if (format == "ply") mesh = MeshFromPly(ply::Parse(bytes, name), name);
+  else if (format == "obj") mesh = ParseObj(bytes, name);
+  else if (format == "off") mesh = ParseOff(bytes, name);
+  else if (format == "stl") mesh = ParseStl(bytes, name);
+  else throw InputError(name, "unknown mesh format '" + format + "'");
+  CheckFiniteVertices(mesh, name);
   return mesh;
 }
 

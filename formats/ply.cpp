@@ -38,6 +38,26 @@ bool HostIsLittleEndian() {
 
 bool IsIntegral(Type t) { return t != Type::kFloat32 && t != Type::kFloat64; }
 
+double IntegralMin(Type t) {
+  switch (t) {
+    case Type::kInt8: return -128;
+    case Type::kInt16: return -32768;
+    case Type::kInt32: return -2147483648.0;
+    default: return 0;
+  }
+}
+
+double IntegralMax(Type t) {
+  switch (t) {
+    case Type::kInt8: return 127;
+    case Type::kUInt8: return 255;
+    case Type::kInt16: return 32767;
+    case Type::kUInt16: return 65535;
+    case Type::kInt32: return 2147483647.0;
+    default: return 4294967295.0;
+  }
+}
+
 // Reads one binary scalar at p (swapping bytes if the file's order differs from the host's).
 double DecodeBinary(const unsigned char* p, Type t, bool swap) {
   unsigned char b[8];
@@ -131,13 +151,18 @@ class BodyReader {
     char* parse_end = nullptr;
     errno = 0;
     const double v = std::strtod(token.c_str(), &parse_end);
-    if (parse_end == token.c_str() || *parse_end != '\0') {
+    if (parse_end == token.c_str() || parse_end != token.c_str() + token.size()) {  // also a NUL inside
       throw InputError(name_, "element '" + e.name + "' item " + std::to_string(item) + " property '" + prop +
                                   "': '" + token + "' is not a number");
     }
     if (IsIntegral(t) && std::isfinite(v) && v != std::floor(v)) {
       throw InputError(name_, "element '" + e.name + "' item " + std::to_string(item) + " property '" + prop +
                                   "': '" + token + "' is not an integer");
+    }
+    // A binary value always fits its type; an ASCII one must too, or writing it back would wrap it.
+    if (IsIntegral(t) && !(v >= IntegralMin(t) && v <= IntegralMax(t))) {
+      throw InputError(name_, "element '" + e.name + "' item " + std::to_string(item) + " property '" + prop +
+                                  "': " + token + " does not fit a " + TypeName(t));
     }
     // A float32 property holds a float: "%.9g" text converts back to exactly the float that was written.
     return t == Type::kFloat32 ? static_cast<double>(static_cast<float>(v)) : v;
@@ -251,7 +276,7 @@ File Parse(const std::string& bytes, const std::string& name) {
     if (nl == std::string::npos) nl = bytes.size();
     *line = bytes.substr(pos, nl - pos);
     if (!line->empty() && line->back() == '\r') line->pop_back();
-    pos = nl + 1;
+    pos = std::min(nl + 1, bytes.size());  // a last line without '\n' ends the bytes, never beyond them
     ++line_no;
     return true;
   };
@@ -286,7 +311,7 @@ File Parse(const std::string& bytes, const std::string& name) {
       char* end = nullptr;
       errno = 0;
       const unsigned long long count = std::strtoull(words[2].c_str(), &end, 10);
-      if (*end != '\0' || words[2][0] == '-' || errno == ERANGE)
+      if (end != words[2].data() + words[2].size() || words[2][0] == '-' || errno == ERANGE)
         header_error("element '" + words[1] + "' has a bad count '" + words[2] + "'");
       Element e;
       e.name = words[1];
@@ -309,6 +334,7 @@ File Parse(const std::string& bytes, const std::string& name) {
       }
       file.elements.back().properties.push_back(std::move(p));
     } else if (key == "end_header") {
+      if (words.size() != 1) header_error("'end_header' must be alone on its line");
       ended = true;
       break;
     } else {
@@ -350,6 +376,9 @@ File Parse(const std::string& bytes, const std::string& name) {
     }
   }
   for (auto& e : file.elements) {
+    // Items of no property take no bytes: nothing to read, however many the header declares (a loop over
+    // 10^19 of them would never end).
+    if (e.properties.empty()) continue;
     for (auto& p : e.properties) {
       if (!p.is_list) p.values.reserve(e.count);
       else p.list_sizes.reserve(e.count);
@@ -400,6 +429,7 @@ std::string Serialize(const File& file) {
   const bool swap = (file.encoding == Encoding::kBinaryLittleEndian) != HostIsLittleEndian();
   out.reserve(out.size() + (ascii ? 4 * body_bytes : body_bytes));
   for (const auto& e : file.elements) {
+    if (e.properties.empty()) continue;  // items of no property are no bytes (as the parser reads them)
     std::vector<size_t> cursor(e.properties.size(), 0);
     for (size_t item = 0; item < e.count; ++item) {
       for (size_t k = 0; k < e.properties.size(); ++k) {

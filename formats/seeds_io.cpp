@@ -3,6 +3,7 @@
 #include "common/errors.h"
 #include "common/input_file.h"
 #include "formats/kinds.h"
+#include "formats/ply.h"
 
 namespace voroudf {
 
@@ -13,9 +14,9 @@ void SeedCloud::Resize(size_t n) {
   rank.resize(n, kRankUnknown);
 }
 
-SeedCloud ReadSeeds(const std::string& file_path) {
-  const ply::File file = ply::Read(file_path);
-  const std::string path = InputName(file_path);
+SeedCloud ReadSeeds(const std::string& path) { return SeedsFromPly(ply::Read(path), InputName(path)); }
+
+SeedCloud SeedsFromPly(const ply::File& file, const std::string& path) {
   CheckDeclaredKind(file, path, "seeds", kSeedsFormatVersion);
   if (FindDeclaredKind(file).kind.empty()) {
     const ply::Element* faces = file.Find("face");

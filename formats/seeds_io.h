@@ -6,6 +6,7 @@
 
 #include "common/provenance.h"
 #include "common/types.h"
+#include "formats/ply.h"
 
 namespace voroudf {
 
@@ -26,6 +27,8 @@ struct SeedCloud {
 /// Reads a seeds file. x y z are required; nx ny nz, udf and rank are optional so that point clouds
 /// written by other tools can be used. Throws InputError (exit 3) for anything malformed.
 SeedCloud ReadSeeds(const std::string& path);
+/// The same from a PLY file already parsed; `name` names it in messages.
+SeedCloud SeedsFromPly(const ply::File& file, const std::string& name);
 
 /// Writes atomically, binary little-endian unless `ascii`.
 void WriteSeeds(const std::string& path, const SeedCloud& seeds, const Provenance& provenance, bool ascii = false);

@@ -1,0 +1,7 @@
+// libFuzzer entry point: voroudf::fuzz::Ply (tests/fuzz/harnesses.h). Run by pipelines/fuzz.sh.
+#include "tests/fuzz/harnesses.h"
+
+extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
+  voroudf::fuzz::Ply(data, size);
+  return 0;
+}
