@@ -175,6 +175,13 @@ class BodyReader {
   bool swap_;
 };
 
+// A count that may exceed every integer type (a header can declare 10^19 items of 8 bytes).
+std::string Whole(long double x) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.0Lf", x);
+  return buf;
+}
+
 // A comment is one header line: control characters (a newline in a --udf path, say) would end it and
 // let the rest be read as header keywords, so they are written as \xNN.
 std::string EscapeComment(const std::string& c) {
@@ -353,8 +360,7 @@ File Parse(const std::string& bytes, const std::string& name) {
     for (const auto& e : file.elements)
       values += static_cast<long double>(e.properties.size()) * static_cast<long double>(e.count);
     if (values > static_cast<long double>(body.Remaining() + 1) / 2)
-      throw InputError(name, "file is shorter than its header promises (" +
-                                 std::to_string(static_cast<unsigned long long>(values)) + " values declared, " +
+      throw InputError(name, "file is shorter than its header promises (" + Whole(values) + " values declared, " +
                                  std::to_string(body.Remaining()) + " bytes of ASCII data): truncated file?");
   }
   // A binary body of fixed-size items can be checked against the file size before anything is allocated.
@@ -371,7 +377,7 @@ File Parse(const std::string& bytes, const std::string& name) {
     }
     if (need > static_cast<long double>(body.Remaining())) {
       throw InputError(name, std::string("file is shorter than its header promises") +
-                                 (has_list ? " (at least " : " (") + std::to_string(static_cast<unsigned long long>(need)) +
+                                 (has_list ? " (at least " : " (") + Whole(need) +
                                  " bytes of data, " + std::to_string(body.Remaining()) + " present): truncated file?");
     }
   }

@@ -20,6 +20,7 @@
 #include "common/morton.h"
 #include "common/projection.h"
 #include "common/rng.h"
+#include "stages/build-gvd/restricted_dual.h"
 
 namespace voroudf {
 namespace {
@@ -368,6 +369,14 @@ GvdResult BuildGvd(const Udf& udf, const SeedCloud& seeds, const BuildGvdOptions
   for (auto& v : per_thread) faces.insert(faces.end(), v.begin(), v.end());
   std::sort(faces.begin(), faces.end());
   faces.erase(std::unique(faces.begin(), faces.end()), faces.end());
+  if (options.dual == "delaunay") {
+    RestrictedDualStats rd;
+    faces = RestrictedDual(seeds.position, faces, options.flat_dihedral_deg, &rd);
+    monitor.Info(Format("restricted dual: %zu Delaunay facets, %zu of %zu witnessed triples are facets; %zu flat "
+                        "tetrahedra resolved (%zu faces added, %zu dropped)",
+                        rd.delaunay_faces, rd.witnessed_delaunay, rd.witnessed, rd.flat_cells_resolved, rd.faces_added,
+                        rd.faces_dropped));
+  }
   // 6. Junctions the samples skipped. Around a region, the neighbouring region can change from j to k along a
   // path of samples none of which sees i, j and k at once (the random samples leave a gap right at the
   // junction); the three borders then each get one triangle fewer than they should, and the mesh a triangular

@@ -5,6 +5,7 @@
 // thin-mesh then thins.
 #include <cstddef>
 #include <cstdint>
+#include <string>
 
 #include "common/monitor.h"
 #include "common/types.h"
@@ -35,6 +36,10 @@ struct BuildGvdOptions {
   /// Adds the triangle of three single-face thick-mesh edges that form a cycle: a junction of three regions
   /// that no sample saw (--close-skipped-junctions; BuildGvd step 6).
   bool close_skipped_junctions = true;
+  /// --dual: "delaunay", the witnessed triples that are facets of the seeds' 3-D Delaunay triangulation
+  /// (restricted_dual.h); "paper", every witnessed triple (the thick dual of the paper).
+  std::string dual = "paper";
+  double flat_dihedral_deg = 20.0;  ///< --flat-dihedral: a Delaunay tetrahedron flatter than this is a degenerate junction
   uint64_t seed = 0;           ///< RNG seed of the dense samples (--seed)
   double proj_tol_rel = 1e-5;  ///< samples converge once d < proj_tol_rel * diagonal (--proj-tol-rel)
   int proj_max_iters = 50;     ///< projection steps before a sample is dropped (--proj-max-iters)

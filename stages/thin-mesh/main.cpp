@@ -23,6 +23,8 @@ int main(int argc, char** argv) {
                  "faces with triangle quality below this are dropped as degenerate (0: only zero area)");
   app.add_option("--fold-flatness", options.fold_flatness_deg,
                  "re-triangulate faces around a non-manifold edge within this angle (deg) of a plane (0: off)");
+  app.add_option("--thinning", options.thinning, "paper: only the paper's steps; repair: also steps 0b, 4-6")
+      ->check(CLI::IsMember({"paper", "repair"}));
 
   return cli.Run(argc, argv, [&] { options.Check(); }, [&](voroudf::Monitor& monitor) {
     const auto udf = cli.OpenUdf(monitor);

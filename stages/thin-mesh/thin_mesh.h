@@ -3,6 +3,7 @@
 // mesh by removing face pairs from closed tetrahedra, then removes small components, keeping the edges that
 // are shared by 3+ faces where the surface really branches.
 #include <cstddef>
+#include <string>
 
 #include "common/monitor.h"
 #include "common/types.h"
@@ -23,6 +24,9 @@ struct ThinMeshOptions {
   /// of a sheet rather than a branching of the surface, and the result has fewer non-manifold edges and no
   /// more boundary edges.
   double fold_flatness_deg = 25.0;
+  /// --thinning: "paper" runs only the paper's steps (drop degenerate and duplicate faces, tetrahedra,
+  /// small components); "repair" (prototype) also the split of step 0 and steps 4-6.
+  std::string thinning = "repair";
 
   /// Throws UsageError for values that cannot work.
   void Check() const;
