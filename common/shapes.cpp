@@ -226,4 +226,42 @@ std::unique_ptr<AnalyticUdf> MakeShape(const std::string& name) {
   throw InputError("shape:" + name, "unknown built-in shape (known: " + known + ")");
 }
 
+namespace {
+
+std::vector<Vec3> Segment(const Vec3& a, const Vec3& b) {
+  std::vector<Vec3> line;
+  const int n = 1000;
+  for (int i = 0; i <= n; ++i) line.push_back(a + (b - a) * (static_cast<double>(i) / n));
+  return line;
+}
+
+}  // namespace
+
+ShapeTopology KnownTopology(const std::string& name) {
+  ShapeTopology t;
+  // chi of a union = sum of the parts' chi - sum over pairwise intersections + the triple one.
+  if (name == "sphere" || name == "cube") t.euler = 2;
+  else if (name == "disc" || name == "hemisphere") t.euler = 1;
+  else if (name == "torus") t.euler = 0;
+  else if (name == "crossing-planes") {
+    t.euler = 1 + 1 - 1;  // two squares, one common segment
+    t.branching_curves = {Segment(Vec3(0, -0.5, 0), Vec3(0, 0.5, 0))};
+  } else if (name == "sphere-disc") {
+    t.euler = 2 + 1 - 0;  // sphere and disc glued along a circle (chi 0)
+    std::vector<Vec3> circle;
+    for (int i = 0; i <= 4000; ++i) {
+      const double a = 2 * M_PI * i / 4000;
+      circle.emplace_back(0.5 * std::cos(a), 0.5 * std::sin(a), 0.0);
+    }
+    t.branching_curves = {circle};
+  } else if (name == "three-discs") {
+    t.euler = 3 - 3 + 1;  // three discs, three common diameters, one common centre
+    t.branching_curves = {Segment(Vec3(-0.5, 0, 0), Vec3(0.5, 0, 0)), Segment(Vec3(0, -0.5, 0), Vec3(0, 0.5, 0)),
+                          Segment(Vec3(0, 0, -0.5), Vec3(0, 0, 0.5))};
+  } else {
+    throw InputError("shape:" + name, "no known topology");
+  }
+  return t;
+}
+
 }  // namespace voroudf

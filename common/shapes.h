@@ -53,4 +53,14 @@ std::vector<std::pair<std::string, std::string>> ShapeCatalog();
 /// Builds the named shape; throws InputError listing the known names for an unknown one.
 std::unique_ptr<AnalyticUdf> MakeShape(const std::string& name);
 
+/// What is known in closed form of a built-in shape's topology, for tests and the robustness sweep.
+struct ShapeTopology {
+  long long euler = 0;  ///< Euler characteristic of the surface
+  /// Its non-manifold curves (where 3+ sheets meet) as polylines with points every 1e-3 or closer; empty
+  /// for a shape without one.
+  std::vector<std::vector<Vec3>> branching_curves;
+};
+/// \pre `name` is in ShapeCatalog()
+ShapeTopology KnownTopology(const std::string& name);
+
 }  // namespace voroudf

@@ -371,11 +371,9 @@ GvdResult BuildGvd(const Udf& udf, const SeedCloud& seeds, const BuildGvdOptions
   faces.erase(std::unique(faces.begin(), faces.end()), faces.end());
   if (options.dual == "delaunay") {
     RestrictedDualStats rd;
-    faces = RestrictedDual(seeds.position, faces, options.flat_dihedral_deg, &rd);
-    monitor.Info(Format("restricted dual: %zu Delaunay facets, %zu of %zu witnessed triples are facets; %zu flat "
-                        "tetrahedra resolved (%zu faces added, %zu dropped)",
-                        rd.delaunay_faces, rd.witnessed_delaunay, rd.witnessed, rd.flat_cells_resolved, rd.faces_added,
-                        rd.faces_dropped));
+    faces = LocallyDelaunayTriples(seeds.position, faces, options.junction_flatness, &rd);
+    monitor.Info(Format("locally Delaunay: %zu of %zu witnessed triples kept (%zu collinear)", rd.kept, rd.witnessed,
+                        rd.degenerate));
   }
   // 6. Junctions the samples skipped. Around a region, the neighbouring region can change from j to k along a
   // path of samples none of which sees i, j and k at once (the random samples leave a gap right at the

@@ -39,7 +39,9 @@ struct BuildGvdOptions {
   /// --dual: "delaunay", the witnessed triples that are facets of the seeds' 3-D Delaunay triangulation
   /// (restricted_dual.h); "paper", every witnessed triple (the thick dual of the paper).
   std::string dual = "paper";
-  double flat_dihedral_deg = 20.0;  ///< --flat-dihedral: a Delaunay tetrahedron flatter than this is a degenerate junction
+  /// --junction-flatness: with --dual delaunay, how far from a triangle's plane (x its circumradius) a fourth
+  /// seed of its junction may lie and still decide which triangles the junction keeps.
+  double junction_flatness = 0.25;
   uint64_t seed = 0;           ///< RNG seed of the dense samples (--seed)
   double proj_tol_rel = 1e-5;  ///< samples converge once d < proj_tol_rel * diagonal (--proj-tol-rel)
   int proj_max_iters = 50;     ///< projection steps before a sample is dropped (--proj-max-iters)

@@ -1,7 +1,6 @@
 #pragma once
-// The dual of the geodesic Voronoi diagram as a subcomplex of the seeds' 3-D Delaunay triangulation
-// (docs/build-gvd.md, "The dual"): one construction with a stated invariant in place of the thick dual and
-// its repair passes.
+// The dual of the geodesic Voronoi diagram, one triangulation per junction instead of every triple a
+// junction's samples see (docs/build-gvd.md, "The dual").
 #include <cstddef>
 #include <vector>
 
@@ -10,30 +9,32 @@
 namespace voroudf {
 
 struct RestrictedDualStats {
-  size_t delaunay_faces = 0;      ///< finite facets of the seeds' 3-D Delaunay triangulation
-  size_t witnessed = 0;           ///< witnessed triples given
-  size_t witnessed_delaunay = 0;  ///< of those, Delaunay facets (kept)
-  size_t flat_cells_resolved = 0; ///< flat tetrahedra whose kept faces folded, replaced by their 2-D Delaunay faces
-  size_t faces_added = 0;         ///< faces those replacements added that no sample witnessed
-  size_t faces_dropped = 0;       ///< witnessed faces those replacements dropped
+  size_t witnessed = 0;     ///< witnessed triples given
+  size_t kept = 0;          ///< of those, locally Delaunay (kept)
+  size_t degenerate = 0;    ///< of those, collinear seeds (no circumsphere): dropped
 };
 
-/// The faces of the dual: the witnessed triples (seed triples whose geodesic Voronoi regions meet, from
-/// the labelled samples) that are facets of the 3-D Delaunay triangulation of `seeds`.
+/// The locally Delaunay witnessed triples. A witnessed triple (i, j, k) — three seeds whose geodesic
+/// Voronoi regions meet, from the labelled samples — is dropped when a seed that is a geodesic neighbour
+/// of all three (it shares a witnessed triple with each) lies within `flat` x R of the triangle's plane and
+/// strictly inside its circumcircle (R its radius): then the four regions meet at one junction, and the
+/// triangle is not a face of that junction's Delaunay triangulation.
 ///
-/// Invariant: the result is a subcomplex of Del(seeds), so no two of its triangles cross or overlap
-/// except in a shared edge or vertex, and no triangle appears twice. The one overlap a subcomplex still
-/// allows is inside a flat tetrahedron (four seeds on one sheet, nearly on a circle: all four of its
-/// faces are witnessed where four regions meet at one point); there the faces of its two triangulations
-/// fold over each other. A Delaunay tetrahedron whose dihedral angle at an edge is below
-/// `flat_dihedral_deg` with at least three kept faces is such a degenerate junction, and its kept faces
-/// are replaced by the 2-D Delaunay triangulation of its four seeds in their best-fit plane (two faces, or
-/// three around a seed inside the others' triangle): the triangulation the restricted Voronoi diagram of
-/// a plane gives.
+/// Why: where n >= 4 regions meet at nearly one point the samples witness all C(n, 3) triples, which stack
+/// into closed tetrahedra and folds (the thick dual). Among the seeds of one junction on a sheet, nearly
+/// coplanar, the triples that survive are the Delaunay triangulation of those seeds in their plane — the
+/// dual the Voronoi diagram of a plane has: a disc of n - 2 triangles, never a tetrahedron (Delaunay 1934;
+/// on surfaces, the restricted Delaunay triangulation, Edelsbrunner & Shah 1997). Only the common
+/// geodesic neighbours are tested, so seeds across a thin gap (the other side of a plate, whose regions
+/// never meet these) never block; and only nearly coplanar ones, so a crease's other face never blocks.
+/// Seeds exactly on the circle (a perfectly cocircular junction) do not block either: both triangulations
+/// of such a junction stay, and thin-mesh chooses.
 ///
-/// \param seeds      seed positions (coincident seeds: the later ones get no face)
-/// \param witnessed  sorted triples of seed indices, each vertex triple once, smallest index first
-std::vector<Tri> RestrictedDual(const std::vector<Vec3>& seeds, const std::vector<Tri>& witnessed,
-                                double flat_dihedral_deg, RestrictedDualStats* stats);
+/// \param seeds      seed positions
+/// \param witnessed  triples of seed indices, each vertex triple once, indices sorted
+/// \param flat       how far from a triangle's plane, relative to its circumradius, a seed still counts
+/// \returns the kept triples in the order given
+std::vector<Tri> LocallyDelaunayTriples(const std::vector<Vec3>& seeds, const std::vector<Tri>& witnessed, double flat,
+                                        RestrictedDualStats* stats);
 
 }  // namespace voroudf

@@ -1,0 +1,145 @@
+// The dual as a subcomplex of the seeds' Delaunay triangulation (stages/build-gvd/restricted_dual.h):
+// properties that a wrong construction breaks. A junction of 5-6 regions gives a disc, never a tetrahedron;
+// randomly perturbed well-spaced seeds on the sphere and the torus give closed 2-manifolds of chi 2 and 0;
+// two planes crossing at random angles keep exactly their crossing line as branching edges.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "common/mesh_topology.h"
+#include "common/rng.h"
+#include "common/shapes.h"
+#include "pipelines/tools/curve_check.h"
+#include "stages/build-gvd/build_gvd.h"
+#include "stages/build-gvd/restricted_dual.h"
+#include "stages/optimize-seeds/optimize_seeds.h"
+#include "stages/sample-seeds/sample_seeds.h"
+#include "stages/thin-mesh/thin_mesh.h"
+
+namespace voroudf {
+namespace {
+
+std::vector<Tri> AllTriples(int n) {
+  std::vector<Tri> t;
+  for (int a = 0; a < n; ++a)
+    for (int b = a + 1; b < n; ++b)
+      for (int c = b + 1; c < n; ++c) t.push_back({a, b, c});
+  return t;
+}
+
+// n seeds near a circle of radius 1 in the plane z = 0, lifted by up to `lift` out of it and moved by up to
+// `jitter` of their spacing along it and half that across (a junction where n regions nearly meet).
+std::vector<Vec3> Ring(int n, double lift, double jitter, uint64_t seed) {
+  std::vector<Vec3> p;
+  for (int k = 0; k < n; ++k) {
+    Rng rng(seed, static_cast<uint64_t>(k));
+    const double a = 2 * M_PI * (k + jitter * rng.Uniform(-1, 1)) / n, r = 1 + 0.5 * jitter * rng.Uniform(-1, 1);
+    p.emplace_back(r * std::cos(a), r * std::sin(a), lift * rng.Uniform(-1, 1));
+  }
+  return p;
+}
+
+TEST(RestrictedDual, AJunctionOfFiveOrSixRegionsIsADiscNotATetrahedronCluster) {
+  for (int n : {4, 5, 6})
+    for (uint64_t seed = 1; seed <= 20; ++seed) {
+      // Every triple witnessed: the paper's dual rule at such a junction gives all C(n, 3) of them.
+      TriangleMesh mesh;
+      mesh.vertices = Ring(n, 1e-3, 0.2, seed);
+      mesh.faces = LocallyDelaunayTriples(mesh.vertices, AllTriples(n), 0.25, nullptr);
+      const TopologyStats t = ComputeTopology(mesh);
+      EXPECT_EQ(mesh.faces.size(), static_cast<size_t>(n - 2)) << n << " seeds, seed " << seed;
+      EXPECT_EQ(t.nonmanifold_edges, 0u) << n;
+      EXPECT_EQ(t.boundary_edges, static_cast<size_t>(n)) << n << ": the polygon's outline";
+      EXPECT_EQ(t.euler, 1) << n;
+      EXPECT_EQ(t.components, 1u) << n;
+    }
+}
+
+// `base` (seeds spread evenly on a shape), each moved by up to `perturb` x the spacing along the surface and projected back.
+SeedCloud PerturbedSeeds(const Udf& udf, const std::vector<Vec3>& base, double spacing, double perturb, uint64_t seed) {
+  SeedCloud s;
+  for (size_t i = 0; i < base.size(); ++i) {
+    Rng rng(seed, i);
+    Vec3 p = base[i] + perturb * spacing * Vec3(rng.Uniform(-1, 1), rng.Uniform(-1, 1), rng.Uniform(-1, 1));
+    for (int it = 0; it < 50; ++it) {
+      Vec3 n;
+      const double d = udf.Distance(p, &n);
+      if (d < 1e-9) break;
+      p -= d * n;
+    }
+    s.position.push_back(p);
+  }
+  s.Resize(s.position.size());
+  return s;
+}
+
+TriangleMesh Mesh(const Udf& udf, const SeedCloud& seeds) {
+  BuildGvdOptions g;
+  g.dual = "delaunay";
+  const GvdResult gvd = BuildGvd(udf, seeds, g, false, Monitor::Null());
+  ThinMeshOptions t;
+  t.thinning = "paper";
+  return ThinMesh(udf, gvd.thick, t, Monitor::Null());
+}
+
+TEST(RestrictedDual, PerturbedWellSpacedSeedsGiveClosedManifoldsOfTheRightGenus) {
+  const auto sphere = MakeShape("sphere");
+  std::vector<Vec3> fib;
+  const int n = 800;
+  for (int i = 0; i < n; ++i) {
+    const double z = 1 - (2 * i + 1.0) / n, r = std::sqrt(1 - z * z), a = i * M_PI * (3 - std::sqrt(5.0));
+    fib.push_back(0.5 * Vec3(r * std::cos(a), r * std::sin(a), z));
+  }
+  const double sphere_spacing = std::sqrt(4 * M_PI * 0.25 / n);
+  const auto torus = MakeShape("torus");
+  std::vector<Vec3> rings;
+  const double R = 0.35, r = 0.15, torus_spacing = 0.035;
+  const int minor = static_cast<int>(std::round(2 * M_PI * r / torus_spacing));
+  for (int j = 0; j < minor; ++j) {
+    const double v = 2 * M_PI * j / minor, radius = R + r * std::cos(v);
+    const int major = static_cast<int>(std::round(2 * M_PI * radius / torus_spacing));
+    for (int i = 0; i < major; ++i) {
+      const double u = 2 * M_PI * (i + 0.5 * (j % 2)) / major;
+      rings.emplace_back(radius * std::cos(u), radius * std::sin(u), r * std::sin(v));
+    }
+  }
+  for (uint64_t seed = 1; seed <= 4; ++seed) {
+    const TopologyStats s = ComputeTopology(Mesh(*sphere, PerturbedSeeds(*sphere, fib, sphere_spacing, 0.25, seed)));
+    EXPECT_EQ(s.euler, 2) << "sphere, seed " << seed;
+    EXPECT_EQ(s.nonmanifold_edges, 0u) << "sphere, seed " << seed;
+    EXPECT_EQ(s.boundary_edges, 0u) << "sphere, seed " << seed;
+    const TopologyStats t = ComputeTopology(Mesh(*torus, PerturbedSeeds(*torus, rings, torus_spacing, 0.25, seed)));
+    EXPECT_EQ(t.euler, 0) << "torus, seed " << seed;
+    EXPECT_EQ(t.nonmanifold_edges, 0u) << "torus, seed " << seed;
+    EXPECT_EQ(t.boundary_edges, 0u) << "torus, seed " << seed;
+  }
+}
+
+TEST(RestrictedDual, PlanesCrossingAtRandomAnglesKeepExactlyTheirLine) {
+  for (uint64_t seed = 1; seed <= 3; ++seed) {
+    Rng rng(seed, 99);
+    const double angle = rng.Uniform(30, 90) * M_PI / 180;
+    const Vec3 o = Vec3::Zero(), x(1, 0, 0), y(0, 1, 0);
+    const Vec3 tilted(0, std::cos(angle), std::sin(angle));  // the second plane, through the x axis
+    std::vector<std::unique_ptr<Primitive>> parts;
+    parts.push_back(MakeRectangle(o, x, y, 0.5, 0.5));
+    parts.push_back(MakeRectangle(o, x, tilted, 0.5, 0.5));
+    const AnalyticUdf udf("two-planes", "two squares crossing along the x axis",
+                          Box{Vec3(-0.6, -0.6, -0.6), Vec3(0.6, 0.6, 0.6)}, std::move(parts));
+    SampleSeedsOptions so;
+    so.count = 2000;
+    so.seed = seed;
+    const SeedCloud seeds = OptimizeSeeds(udf, SampleSeeds(udf, so, Monitor::Null()), {}, Monitor::Null());
+    ShapeTopology truth;
+    truth.euler = 1;
+    truth.branching_curves.emplace_back();
+    for (int i = 0; i <= 1000; ++i) truth.branching_curves[0].emplace_back(-0.5 + i / 1000.0, 0, 0);
+    const BranchingCheck c = CheckBranchingCurves(Mesh(udf, seeds), truth, 1e-3, 0);
+    EXPECT_GT(c.nonmanifold_edges, 10u) << angle * 180 / M_PI << " deg";
+    EXPECT_EQ(c.off_curve, 0u) << angle * 180 / M_PI << " deg: branching edges off the line (max " << c.max_offset << ")";
+    EXPECT_LE(c.longest_gap, 3 * c.mean_edge) << angle * 180 / M_PI << " deg: the line is not covered";
+  }
+}
+
+}  // namespace
+}  // namespace voroudf
