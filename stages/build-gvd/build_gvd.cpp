@@ -371,7 +371,12 @@ GvdResult BuildGvd(const Udf& udf, const SeedCloud& seeds, const BuildGvdOptions
   faces.erase(std::unique(faces.begin(), faces.end()), faces.end());
   if (options.dual == "delaunay") {
     RestrictedDualStats rd;
-    faces = LocallyDelaunayTriples(seeds.position, faces, options.junction_flatness, &rd);
+    std::vector<Vec3> seed_normal(num_seeds, Vec3::Zero());
+    for (size_t u = 0; u < n; ++u)
+      if (node_seed[u] >= 0) seed_normal[static_cast<size_t>(node_seed[u])] = node_n[u];
+    std::vector<uint8_t> on_sheet(num_seeds);
+    for (size_t i = 0; i < num_seeds; ++i) on_sheet[i] = seeds.rank[i] <= kRankSheet;
+    faces = LocallyDelaunayTriples(seeds.position, seed_normal, on_sheet, faces, options.chart_angle_deg, &rd);
     monitor.Info(Format("locally Delaunay: %zu of %zu witnessed triples kept (%zu collinear)", rd.kept, rd.witnessed,
                         rd.degenerate));
   }

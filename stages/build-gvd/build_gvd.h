@@ -39,9 +39,9 @@ struct BuildGvdOptions {
   /// --dual: "delaunay", the witnessed triples that are facets of the seeds' 3-D Delaunay triangulation
   /// (restricted_dual.h); "paper", every witnessed triple (the thick dual of the paper).
   std::string dual = "paper";
-  /// --junction-flatness: with --dual delaunay, how far from a triangle's plane (x its circumradius) a fourth
-  /// seed of its junction may lie and still decide which triangles the junction keeps.
-  double junction_flatness = 0.25;
+  /// --chart-angle: with --dual delaunay, the four seeds of a junction share a chart (their tangent plane
+  /// decides which triangles it keeps) when their normals agree within this angle, degrees.
+  double chart_angle_deg = 25.0;
   uint64_t seed = 0;           ///< RNG seed of the dense samples (--seed)
   double proj_tol_rel = 1e-5;  ///< samples converge once d < proj_tol_rel * diagonal (--proj-tol-rel)
   int proj_max_iters = 50;     ///< projection steps before a sample is dropped (--proj-max-iters)

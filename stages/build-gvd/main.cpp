@@ -30,8 +30,8 @@ int main(int argc, char** argv) {
                  "add the triangle of 3 single-face edges forming a cycle (a junction no sample saw)");
   app.add_option("--dual", options.dual, "delaunay: witnessed triples that are Delaunay facets; paper: all witnessed")
       ->check(CLI::IsMember({"delaunay", "paper"}));
-  app.add_option("--junction-flatness", options.junction_flatness,
-                 "with --dual delaunay: a fourth seed within this x circumradius of a triangle's plane decides");
+  app.add_option("--chart-angle", options.chart_angle_deg,
+                 "with --dual delaunay: seeds whose normals agree within this angle (deg) share a chart");
   app.add_option("--proj-tol-rel", options.proj_tol_rel, "projection tolerance on d, relative to the diagonal");
   app.add_option("--proj-max-iters", options.proj_max_iters, "projection steps before a sample is dropped");
 

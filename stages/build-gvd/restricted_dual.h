@@ -2,6 +2,7 @@
 // The dual of the geodesic Voronoi diagram, one triangulation per junction instead of every triple a
 // junction's samples see (docs/build-gvd.md, "The dual").
 #include <cstddef>
+#include <cstdint>
 #include <vector>
 
 #include "common/types.h"
@@ -15,26 +16,30 @@ struct RestrictedDualStats {
 };
 
 /// The locally Delaunay witnessed triples. A witnessed triple (i, j, k) — three seeds whose geodesic
-/// Voronoi regions meet, from the labelled samples — is dropped when a seed that is a geodesic neighbour
-/// of all three (it shares a witnessed triple with each) lies within `flat` x R of the triangle's plane and
-/// strictly inside its circumcircle (R its radius): then the four regions meet at one junction, and the
-/// triangle is not a face of that junction's Delaunay triangulation.
+/// Voronoi regions meet, from the labelled samples — is dropped when a seed v that is a geodesic neighbour
+/// of all three (it shares a witnessed triple with each) lies strictly inside its circumcircle in the
+/// chart of the four: the plane normal to their mean surface normal, used only when the four normals
+/// agree within `chart_angle_deg` (sign-blind). Then the four regions meet at one junction of a sheet,
+/// and the triangle is not a face of that junction's Delaunay triangulation.
 ///
 /// Why: where n >= 4 regions meet at nearly one point the samples witness all C(n, 3) triples, which stack
-/// into closed tetrahedra and folds (the thick dual). Among the seeds of one junction on a sheet, nearly
-/// coplanar, the triples that survive are the Delaunay triangulation of those seeds in their plane — the
-/// dual the Voronoi diagram of a plane has: a disc of n - 2 triangles, never a tetrahedron (Delaunay 1934;
-/// on surfaces, the restricted Delaunay triangulation, Edelsbrunner & Shah 1997). Only the common
-/// geodesic neighbours are tested, so seeds across a thin gap (the other side of a plate, whose regions
-/// never meet these) never block; and only nearly coplanar ones, so a crease's other face never blocks.
-/// Seeds exactly on the circle (a perfectly cocircular junction) do not block either: both triangulations
-/// of such a junction stay, and thin-mesh chooses.
+/// into closed tetrahedra and folds (the thick dual). Among the seeds of one junction on a sheet, the
+/// triples that survive are the Delaunay triangulation of those seeds in their tangent plane — the dual a
+/// plane's Voronoi diagram has (Delaunay 1934; on surfaces, the restricted Delaunay triangulation,
+/// Edelsbrunner & Shah 1997): a disc of n - 2 triangles, never a tetrahedron. The test of a triangle and a
+/// fourth seed uses the same plane as the test of any other triangle of those four, so the two
+/// triangulations of a quadrilateral never both fail or both pass. Only common geodesic neighbours are
+/// tested, so seeds across a thin gap (the other side of a plate, whose regions never meet these) never
+/// block; and only seeds with the triangle on one chart, so a crease's other face never blocks.
+/// Four seeds exactly on one circle do not block each other: both triangulations stay, thin-mesh chooses.
 ///
 /// \param seeds      seed positions
+/// \param normals    a unit surface normal (UDF gradient) per seed, either orientation; zero: no chart
+/// \param on_sheet   per seed, whether it lies on a sheet (rank 1 or unknown): only those normals count
 /// \param witnessed  triples of seed indices, each vertex triple once, indices sorted
-/// \param flat       how far from a triangle's plane, relative to its circumradius, a seed still counts
-/// \returns the kept triples in the order given
-std::vector<Tri> LocallyDelaunayTriples(const std::vector<Vec3>& seeds, const std::vector<Tri>& witnessed, double flat,
-                                        RestrictedDualStats* stats);
+/// \returns the kept triples in the order given (collinear triples are dropped)
+std::vector<Tri> LocallyDelaunayTriples(const std::vector<Vec3>& seeds, const std::vector<Vec3>& normals,
+                                        const std::vector<uint8_t>& on_sheet, const std::vector<Tri>& witnessed,
+                                        double chart_angle_deg, RestrictedDualStats* stats);
 
 }  // namespace voroudf
