@@ -46,7 +46,7 @@ TEST(RestrictedDual, AJunctionOfFiveOrSixRegionsIsADiscNotATetrahedronCluster) {
       TriangleMesh mesh;
       mesh.vertices = Ring(n, 1e-3, 0.2, seed);
       mesh.faces = LocallyDelaunayTriples(mesh.vertices, std::vector<Vec3>(n, Vec3(0, 0, 1)), std::vector<uint8_t>(n, 1),
-                                          AllTriples(n), 60.0, nullptr);
+                                          AllTriples(n), {}, 25.0, nullptr);
       const TopologyStats t = ComputeTopology(mesh);
       EXPECT_EQ(mesh.faces.size(), static_cast<size_t>(n - 2)) << n << " seeds, seed " << seed;
       EXPECT_EQ(t.nonmanifold_edges, 0u) << n;

@@ -357,6 +357,28 @@ GvdResult BuildGvd(const Udf& udf, const SeedCloud& seeds, const BuildGvdOptions
       }
       std::sort(others.begin(), others.end());
       others.erase(std::unique(others.begin(), others.end()), others.end());
+      if (options.witness == "clique") {
+        // Only graph triangles (u, v, w) with three labels witness a junction: the three regions meet
+        // there, not just within u's neighbourhood.
+        if (others.size() < 2) continue;
+        for (size_t a = offset[u]; a < offset[u + 1]; ++a) {
+          const size_t v = static_cast<size_t>(adj[a]);
+          const int j = label[v];
+          if (j < 0 || j == i || v < u) continue;
+          for (size_t b = a + 1; b < offset[u + 1]; ++b) {
+            const size_t w = static_cast<size_t>(adj[b]);
+            const int k = label[w];
+            if (k < 0 || k == i || k == j || w < u) continue;
+            if (!std::binary_search(adj.begin() + static_cast<long>(offset[v]), adj.begin() + static_cast<long>(offset[v + 1]),
+                                    static_cast<int>(w)))
+              continue;
+            Tri t{i, j, k};
+            std::sort(t.begin(), t.end());
+            out.push_back(t);
+          }
+        }
+        continue;
+      }
       for (size_t p = 0; p < others.size(); ++p)
         for (size_t q = p + 1; q < others.size(); ++q) {
           Tri t{i, others[p], others[q]};
@@ -376,9 +398,17 @@ GvdResult BuildGvd(const Udf& udf, const SeedCloud& seeds, const BuildGvdOptions
       if (node_seed[u] >= 0) seed_normal[static_cast<size_t>(node_seed[u])] = node_n[u];
     std::vector<uint8_t> on_sheet(num_seeds);
     for (size_t i = 0; i < num_seeds; ++i) on_sheet[i] = seeds.rank[i] <= kRankSheet;
-    faces = LocallyDelaunayTriples(seeds.position, seed_normal, on_sheet, faces, options.chart_angle_deg, &rd);
-    monitor.Info(Format("locally Delaunay: %zu of %zu witnessed triples kept (%zu collinear)", rd.kept, rd.witnessed,
-                        rd.degenerate));
+    // Border lengths: the graph edges between differently labelled nodes, per pair of labels.
+    std::unordered_map<uint64_t, size_t> border;
+    for (size_t u = 0; u < n; ++u)
+      for (size_t a = offset[u]; a < offset[u + 1]; ++a) {
+        const size_t v = static_cast<size_t>(adj[a]);
+        if (v <= u || label[u] < 0 || label[v] < 0 || label[u] == label[v]) continue;
+        ++border[EdgeKey(MakeEdge(label[u], label[v]))];
+      }
+    faces = LocallyDelaunayTriples(seeds.position, seed_normal, on_sheet, faces, border, options.chart_angle_deg, &rd);
+    monitor.Info(Format("locally Delaunay: %zu of %zu witnessed triples kept (%zu collinear; %zu tetrahedra opened "
+                        "on their weakest border)", rd.kept, rd.witnessed, rd.degenerate, rd.tetrahedra_opened));
   }
   // 6. Junctions the samples skipped. Around a region, the neighbouring region can change from j to k along a
   // path of samples none of which sees i, j and k at once (the random samples leave a gap right at the

@@ -39,6 +39,9 @@ struct BuildGvdOptions {
   /// --dual: "delaunay", the witnessed triples that are facets of the seeds' 3-D Delaunay triangulation
   /// (restricted_dual.h); "paper", every witnessed triple (the thick dual of the paper).
   std::string dual = "paper";
+  /// --witness: "wide", a node of label i with graph neighbours of labels j and k witnesses (i, j, k) (the
+  /// paper); "clique", only a graph triangle whose three nodes carry i, j and k does.
+  std::string witness = "wide";
   /// --chart-angle: with --dual delaunay, the four seeds of a junction share a chart (their tangent plane
   /// decides which triangles it keeps) when their normals agree within this angle, degrees.
   double chart_angle_deg = 25.0;

@@ -30,6 +30,8 @@ int main(int argc, char** argv) {
                  "add the triangle of 3 single-face edges forming a cycle (a junction no sample saw)");
   app.add_option("--dual", options.dual, "delaunay: witnessed triples that are Delaunay facets; paper: all witnessed")
       ->check(CLI::IsMember({"delaunay", "paper"}));
+  app.add_option("--witness", options.witness, "wide: a node and two neighbours of other labels; clique: a graph triangle")
+      ->check(CLI::IsMember({"wide", "clique"}));
   app.add_option("--chart-angle", options.chart_angle_deg,
                  "with --dual delaunay: seeds whose normals agree within this angle (deg) share a chart");
   app.add_option("--proj-tol-rel", options.proj_tol_rel, "projection tolerance on d, relative to the diagonal");
