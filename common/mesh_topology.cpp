@@ -195,4 +195,29 @@ double TriangleQuality(const Vec3& a, const Vec3& b, const Vec3& c) {
   return 6.0 / std::sqrt(3.0) * area / (half_perimeter * longest);
 }
 
+TriangleMesh CanonicalOrder(const TriangleMesh& mesh) {
+  std::vector<int> order(mesh.vertices.size());
+  for (size_t i = 0; i < order.size(); ++i) order[i] = static_cast<int>(i);
+  std::sort(order.begin(), order.end(), [&](int a, int b) {
+    const Vec3 &p = mesh.vertices[static_cast<size_t>(a)], &q = mesh.vertices[static_cast<size_t>(b)];
+    if (p.x() != q.x()) return p.x() < q.x();
+    if (p.y() != q.y()) return p.y() < q.y();
+    if (p.z() != q.z()) return p.z() < q.z();
+    return a < b;
+  });
+  TriangleMesh out;
+  std::vector<int> rank(order.size());
+  for (size_t k = 0; k < order.size(); ++k) {
+    rank[static_cast<size_t>(order[k])] = static_cast<int>(k);
+    out.vertices.push_back(mesh.vertices[static_cast<size_t>(order[k])]);
+  }
+  for (const Tri& t : mesh.faces) {
+    Tri r{rank[static_cast<size_t>(t[0])], rank[static_cast<size_t>(t[1])], rank[static_cast<size_t>(t[2])]};
+    std::rotate(r.begin(), std::min_element(r.begin(), r.end()), r.end());
+    out.faces.push_back(r);
+  }
+  std::sort(out.faces.begin(), out.faces.end());
+  return out;
+}
+
 }  // namespace voroudf

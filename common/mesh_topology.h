@@ -53,6 +53,12 @@ std::vector<int> EdgeConnectedComponents(const std::vector<Tri>& faces, int* num
 /// drops faces that became degenerate and vertices no face references.
 TriangleMesh WeldVertices(const TriangleMesh& mesh, double tolerance);
 
+/// The same mesh in an order that depends on its geometry alone: vertices sorted by (x, y, z), each face
+/// rotated to start at its smallest vertex index (orientation kept), faces sorted. For generators whose
+/// libraries emit elements in an order that follows memory addresses (CGAL's corefinement), so that the
+/// same geometry always gives the same bytes.
+TriangleMesh CanonicalOrder(const TriangleMesh& mesh);
+
 /// Drops vertices no face references, renumbering the rest in order.
 TriangleMesh RemoveUnreferencedVertices(const TriangleMesh& mesh);
 

@@ -101,5 +101,23 @@ TEST(MeshTopology, TriangleQuality) {
               6 / std::sqrt(3.0) * 0.5 / ((2 + std::sqrt(2.0)) / 2 * std::sqrt(2.0)), 1e-12);
 }
 
+TEST(MeshTopology, CanonicalOrderDependsOnTheGeometryAlone) {
+  // A tetrahedron, and the same with its vertices renumbered, its faces reordered and rotated.
+  const TriangleMesh a{{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}}, {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}}};
+  const int perm[4] = {2, 0, 3, 1};  // new index of old vertex k
+  TriangleMesh b;
+  b.vertices.resize(4);
+  for (int k = 0; k < 4; ++k) b.vertices[perm[k]] = a.vertices[k];
+  for (int f = 3; f >= 0; --f) {
+    const Tri& t = a.faces[f];
+    b.faces.push_back({perm[t[1]], perm[t[2]], perm[t[0]]});  // same orientation, another start
+  }
+  const TriangleMesh ca = CanonicalOrder(a), cb = CanonicalOrder(b);
+  EXPECT_EQ(ca.vertices, cb.vertices);
+  EXPECT_EQ(ca.faces, cb.faces);
+  EXPECT_EQ(ComputeTopology(ca).euler, 2);
+  EXPECT_EQ(ca.vertices[0], Vec3(0, 0, 0));
+}
+
 }  // namespace
 }  // namespace voroudf

@@ -10,7 +10,7 @@ namespace voroudf {
 
 struct BranchingCheck {
   size_t nonmanifold_edges = 0;  ///< edges with 3+ faces
-  size_t off_curve = 0;          ///< of those, the ones with an end or the midpoint farther than `tol` from the curves
+  size_t off_curve = 0;          ///< of those, the ones with an end farther than `tol` from the curves, or the midpoint farther than max(tol, 5 % of the edge)
   double max_offset = 0;         ///< the largest such distance over all non-manifold edges
   double longest_gap = 0;        ///< longest stretch of the curves farther than `tol` from every non-manifold edge
   size_t boundary_edges = 0;

@@ -95,7 +95,7 @@ TriangleMesh MakeOverlapNonManifold(const TriangleMesh& input, const OverlapOpti
   std::map<std::array<double, 3>, int> index;
   Append(negative, index, out);
   Append(positive, index, out);
-  return out;
+  return CanonicalOrder(out);
 }
 
 }  // namespace voroudf

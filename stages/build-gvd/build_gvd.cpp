@@ -400,7 +400,7 @@ GvdResult BuildGvd(const Udf& udf, const SeedCloud& seeds, const BuildGvdOptions
     for (size_t i = 0; i < num_seeds; ++i) on_sheet[i] = seeds.rank[i] <= kRankSheet;
     // Border lengths: the graph edges between differently labelled nodes, per pair of labels.
     std::unordered_map<uint64_t, size_t> border;
-    for (size_t u = 0; u < n; ++u)
+    for (size_t u = 0; u < n && options.open_by_border; ++u)
       for (size_t a = offset[u]; a < offset[u + 1]; ++a) {
         const size_t v = static_cast<size_t>(adj[a]);
         if (v <= u || label[u] < 0 || label[v] < 0 || label[u] == label[v]) continue;

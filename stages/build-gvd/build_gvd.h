@@ -45,6 +45,8 @@ struct BuildGvdOptions {
   /// --chart-angle: with --dual delaunay, the four seeds of a junction share a chart (their tangent plane
   /// decides which triangles it keeps) when their normals agree within this angle, degrees.
   double chart_angle_deg = 25.0;
+  /// --open-by-border: tetrahedra no chart decides lose the two triples on their weakest Voronoi border.
+  bool open_by_border = true;
   uint64_t seed = 0;           ///< RNG seed of the dense samples (--seed)
   double proj_tol_rel = 1e-5;  ///< samples converge once d < proj_tol_rel * diagonal (--proj-tol-rel)
   int proj_max_iters = 50;     ///< projection steps before a sample is dropped (--proj-max-iters)

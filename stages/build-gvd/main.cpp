@@ -32,6 +32,7 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"delaunay", "paper"}));
   app.add_option("--witness", options.witness, "wide: a node and two neighbours of other labels; clique: a graph triangle")
       ->check(CLI::IsMember({"wide", "clique"}));
+  app.add_option("--open-by-border", options.open_by_border, "with --dual delaunay: tetrahedra no chart decides lose the triples on their weakest border");
   app.add_option("--chart-angle", options.chart_angle_deg,
                  "with --dual delaunay: seeds whose normals agree within this angle (deg) share a chart");
   app.add_option("--proj-tol-rel", options.proj_tol_rel, "projection tolerance on d, relative to the diagonal");

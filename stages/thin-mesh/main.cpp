@@ -25,6 +25,7 @@ int main(int argc, char** argv) {
                  "re-triangulate faces around a non-manifold edge within this angle (deg) of a plane (0: off)");
   app.add_option("--thinning", options.thinning, "paper: only the paper's steps; repair: also steps 0b, 4-6")
       ->check(CLI::IsMember({"paper", "repair"}));
+  app.add_option("--repairs", options.repairs, "with --thinning repair: which of split,folds,holes,rims run");
 
   return cli.Run(argc, argv, [&] { options.Check(); }, [&](voroudf::Monitor& monitor) {
     const auto udf = cli.OpenUdf(monitor);

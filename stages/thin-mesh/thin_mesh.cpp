@@ -894,7 +894,8 @@ TriangleMesh ThinMesh(const Udf& udf, const TriangleMesh& thick, const ThinMeshO
   // and thinning cannot recover the curve's edges. Such a face is split into those two (repeatedly: the
   // halves may span further vertices); the halves that exist already are dropped as duplicates below.
   const bool repairs = options.thinning != "paper";
-  if (repairs && !middle.empty()) {
+  auto repair = [&](const char* name) { return repairs && options.repairs.find(name) != std::string::npos; };
+  if (repair("split") && !middle.empty()) {
     std::vector<Tri> split;
     std::vector<Tri> stack(faces.rbegin(), faces.rend());
     while (!stack.empty()) {
@@ -992,21 +993,21 @@ TriangleMesh ThinMesh(const Udf& udf, const TriangleMesh& thick, const ThinMeshO
     if (thinner.alive()[f]) kept.push_back(thinner.faces()[f]);
   // 4. Flat folds.
   const double fold_min_cos = std::cos(options.fold_flatness_deg * M_PI / 180.0);
-  if (repairs && options.fold_flatness_deg > 0.0) {
+  if (repair("folds") && options.fold_flatness_deg > 0.0) {
     st.folds_retriangulated = RetriangulateFlatFolds(thick.vertices, kept, fold_min_cos, options.degenerate_quality, false);
     monitor.Info(Count(st.folds_retriangulated, "flat folds re-triangulated"));
   }
   // 5. Cracks (T-junctions), then triangular holes: three boundary edges that form a cycle are a junction
   // whose face the thinning (or the dual) lost; a true boundary loop of three edges does not occur in a mesh
   // of this resolution.
-  if (repairs) {
+  if (repair("holes")) {
     st.cracks_split = SplitFacesOverCracks(thick.vertices, kept, options.degenerate_quality, fold_min_cos, 0.1);
     if (st.cracks_split > 0) monitor.Info(Count(st.cracks_split, "faces split over a crack (T-junction)"));
     st.holes_closed = CloseTriangularHoles(thick.vertices, kept, options.degenerate_quality, fold_min_cos);
     if (st.holes_closed > 0) monitor.Info(Count(st.holes_closed, "triangular holes closed"));
   }
   // 6. Folds at open rims, once no other repair applies.
-  if (repairs && options.fold_flatness_deg > 0.0) {
+  if (repair("rims") && options.fold_flatness_deg > 0.0) {
     st.rim_folds_opened = RetriangulateFlatFolds(thick.vertices, kept, fold_min_cos, options.degenerate_quality, true);
     if (st.rim_folds_opened > 0) monitor.Info(Count(st.rim_folds_opened, "folds at open rims re-triangulated"));
   }

@@ -25,8 +25,10 @@ struct ThinMeshOptions {
   /// more boundary edges.
   double fold_flatness_deg = 25.0;
   /// --thinning: "paper" runs only the paper's steps (drop degenerate and duplicate faces, tetrahedra,
-  /// small components); "repair" (prototype) also the split of step 0 and steps 4-6.
+  /// small components); "repair" (prototype) also the repairs listed in `repairs`.
   std::string thinning = "repair";
+  /// --repairs (prototype): which of split (step 0b), folds (4), holes (5), rims (6) run with "repair".
+  std::string repairs = "split,folds,holes,rims";
 
   /// Throws UsageError for values that cannot work.
   void Check() const;
