@@ -1,27 +1,12 @@
 #include "common/mesh_topology.h"
 
+#include "common/union_find.h"
+
 #include <algorithm>
 #include <cmath>
 #include <numeric>
 
 namespace voroudf {
-namespace {
-
-struct UnionFind {
-  std::vector<int> parent;
-  explicit UnionFind(size_t n) : parent(n) { std::iota(parent.begin(), parent.end(), 0); }
-  int Find(int x) {
-    while (parent[x] != x) x = parent[x] = parent[parent[x]];
-    return x;
-  }
-  void Unite(int a, int b) {
-    a = Find(a);
-    b = Find(b);
-    if (a != b) parent[std::max(a, b)] = std::min(a, b);
-  }
-};
-
-}  // namespace
 
 int EdgeFaces::Find(int a, int b) const {
   const auto it = index.find(EdgeKey(MakeEdge(a, b)));
@@ -96,7 +81,7 @@ TopologyStats ComputeTopology(const TriangleMesh& mesh) {
       for (int u : mesh.faces[fs[i]]) {
         if (u == static_cast<int>(v)) continue;
         const auto [it, inserted] = first_with.emplace(u, static_cast<int>(i));
-        if (!inserted) uf.Unite(it->second, static_cast<int>(i));
+        if (!inserted) uf.Union(it->second, static_cast<int>(i));
       }
     }
     int fans = 0;
@@ -106,8 +91,8 @@ TopologyStats ComputeTopology(const TriangleMesh& mesh) {
 
   UnionFind comp(nv);
   for (const Tri& t : mesh.faces) {
-    comp.Unite(t[0], t[1]);
-    comp.Unite(t[1], t[2]);
+    comp.Union(t[0], t[1]);
+    comp.Union(t[1], t[2]);
   }
   for (size_t v = 0; v < nv; ++v) s.components += used[v] && comp.Find(static_cast<int>(v)) == static_cast<int>(v);
   return s;
@@ -117,7 +102,7 @@ std::vector<int> EdgeConnectedComponents(const std::vector<Tri>& faces, int* num
   const EdgeFaces ef = BuildEdgeFaces(faces);
   UnionFind uf(faces.size());
   for (const auto& fs : ef.faces)
-    for (size_t k = 1; k < fs.size(); ++k) uf.Unite(fs[0], fs[k]);
+    for (size_t k = 1; k < fs.size(); ++k) uf.Union(fs[0], fs[k]);
   std::vector<int> id(faces.size(), -1), root_id(faces.size(), -1);
   int n = 0;
   for (size_t f = 0; f < faces.size(); ++f) {
@@ -170,7 +155,7 @@ TriangleMesh WeldVertices(const TriangleMesh& mesh, double tolerance) {
             const auto it = grid.find(key_of({c[0] + dx, c[1] + dy, c[2] + dz}));
             if (it == grid.end()) continue;
             for (int u : it->second)
-              if ((mesh.vertices[u] - mesh.vertices[v]).squaredNorm() < tol2) uf.Unite(u, static_cast<int>(v));
+              if ((mesh.vertices[u] - mesh.vertices[v]).squaredNorm() < tol2) uf.Union(u, static_cast<int>(v));
           }
       grid[key_of(c)].push_back(static_cast<int>(v));
     }

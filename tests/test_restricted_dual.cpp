@@ -46,7 +46,7 @@ TEST(RestrictedDual, AJunctionOfFiveOrSixRegionsIsADiscNotATetrahedronCluster) {
       TriangleMesh mesh;
       mesh.vertices = Ring(n, 1e-3, 0.2, seed);
       mesh.faces = LocallyDelaunayTriples(mesh.vertices, std::vector<Vec3>(n, Vec3(0, 0, 1)), std::vector<uint8_t>(n, 1),
-                                          AllTriples(n), {}, 25.0, nullptr);
+                                          AllTriples(n), 25.0, nullptr);
       const TopologyStats t = ComputeTopology(mesh);
       EXPECT_EQ(mesh.faces.size(), static_cast<size_t>(n - 2)) << n << " seeds, seed " << seed;
       EXPECT_EQ(t.nonmanifold_edges, 0u) << n;
@@ -54,6 +54,19 @@ TEST(RestrictedDual, AJunctionOfFiveOrSixRegionsIsADiscNotATetrahedronCluster) {
       EXPECT_EQ(t.euler, 1) << n;
       EXPECT_EQ(t.components, 1u) << n;
     }
+}
+
+TEST(RestrictedDual, ATriangleSpanningASeedOnItsEdgeIsNotKept) {
+  // Seeds 0..4 on a line (a sharp edge or branching curve), a row above; (1, 3, above) spans seed 2, which
+  // lies on its edge 1-3: 2 is inside every circle through 1 and 3, so that triple is no junction's face,
+  // while (1, 2, above) and (2, 3, above) are.
+  std::vector<Vec3> p;
+  for (int i = 0; i < 5; ++i) p.emplace_back(-0.2 + 0.1 * i, 0.0, 0.0);
+  p.emplace_back(0.0, 0.12, 0.0);  // 5
+  const std::vector<Tri> witnessed = {{1, 2, 5}, {1, 3, 5}, {2, 3, 5}, {0, 1, 5}, {3, 4, 5}, {1, 2, 3}};
+  const std::vector<Tri> out =
+      LocallyDelaunayTriples(p, std::vector<Vec3>(6, Vec3(0, 0, 1)), std::vector<uint8_t>(6, 1), witnessed, 25.0, nullptr);
+  EXPECT_EQ(out, (std::vector<Tri>{{1, 2, 5}, {2, 3, 5}, {0, 1, 5}, {3, 4, 5}})) << "and (1, 2, 3) is collinear";
 }
 
 // `base` (seeds spread evenly on a shape), each moved by up to `perturb` x the spacing along the surface and projected back.
@@ -78,9 +91,7 @@ TriangleMesh Mesh(const Udf& udf, const SeedCloud& seeds) {
   BuildGvdOptions g;
   g.dual = "delaunay";
   const GvdResult gvd = BuildGvd(udf, seeds, g, false, Monitor::Null());
-  ThinMeshOptions t;
-  t.thinning = "paper";
-  return ThinMesh(udf, gvd.thick, t, Monitor::Null());
+  return ThinMesh(udf, gvd.thick, ThinMeshOptions{}, Monitor::Null());
 }
 
 TEST(RestrictedDual, PerturbedWellSpacedSeedsGiveClosedManifoldsOfTheRightGenus) {

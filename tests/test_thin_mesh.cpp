@@ -66,17 +66,12 @@ TEST(ThinMesh, FlatTetrahedronLosesThePairWithTheHighestCentroidUdf) {
 
 TEST(ThinMesh, OnlyAPairOnAManifoldEdgeGoesWhenTheTetrahedronSitsInASurface) {
   const auto udf = MakeShape("disc");
-  // Heights make abc + acd (sharing the outer edge ac) the highest pair. Alone, that pair goes (step 1; step 4
-  // off, see below).
+  // Heights make abc + acd (sharing the outer edge ac) the highest pair. Alone, that pair goes (step 1).
   TriangleMesh tet = Tetrahedron(0.03, 0.0, 0.01, 0.0);
   ThinMeshOptions step1_only = MinFaces(1);
-  step1_only.fold_flatness_deg = 0;
+  step1_only.thinning = "paper";
   const std::set<Tri> alone = SortedFaces(ThinMesh(*udf, tet, step1_only, Monitor::Null()));
   EXPECT_EQ(alone, (std::set<Tri>{{0, 1, 3}, {1, 2, 3}}));
-  // abd and bcd overlap (a and c lie on the same side of bd): a fold, which step 4 re-triangulates into the
-  // quad a-c-b-d split along a diagonal.
-  const std::set<Tri> unfolded = SortedFaces(ThinMesh(*udf, tet, MinFaces(1), Monitor::Null()));
-  EXPECT_EQ(unfolded, (std::set<Tri>{{0, 2, 3}, {1, 2, 3}}));
   // Inside a surface: a fan of faces around the quad a-c-b-d makes every outer edge non-manifold, so only the
   // pairs on the diagonals ab or cd may go; of those abc + abd has the higher UDF.
   TriangleMesh surface = tet;
@@ -196,32 +191,6 @@ TEST(ThinMesh, DuplicateAndDegenerateFacesNeverSurvive) {
   for (const Tri& t : out.faces) EXPECT_GT(TriangleQuality(out.vertices[t[0]], out.vertices[t[1]], out.vertices[t[2]]), 0.0);
 }
 
-TEST(ThinMesh, AFaceSpanningAVertexOnItsEdgeIsSplitThere) {
-  const auto udf = MakeShape("disc");
-  // Five seeds on a line (0..4) between two rows; the upper row's dual face (1, 3, s1) spans seed 2, which lies
-  // on its edge, as where seeds along a curve are denser than the samples resolve. The degenerate face
-  // (1, 2, 3) says that 2 lies on edge 1-3; the face is split into (1, 2, s1) and (2, 3, s1), closing the strip.
-  TriangleMesh m;
-  for (int i = 0; i < 5; ++i) m.vertices.push_back({-0.2 + 0.1 * i, 0.0, 0.0});
-  for (double y : {0.1, -0.1})
-    for (double x : {-0.15, 0.0, 0.15}) m.vertices.push_back({x, y, 0.0});
-  const int s0 = 5, s1 = 6, s2 = 7, t0 = 8, t1 = 9, t2 = 10;
-  m.faces = {{0, 1, s0}, {1, s1, s0}, {1, 3, s1}, {3, s2, s1}, {3, 4, s2},                     // upper, spans 2
-             {0, 1, t0}, {1, t1, t0}, {1, 2, t1}, {2, 3, t1}, {3, t2, t1}, {3, 4, t2},         // lower
-             {1, 2, 3}};                                                                      // degenerate
-  ThinMeshStats stats;
-  const TriangleMesh out = ThinMesh(*udf, m, ThinMeshOptions{}, Monitor::Null(), &stats);
-  EXPECT_EQ(stats.faces_split, 1u);
-  const std::set<Tri> faces = SortedFaces(out);
-  EXPECT_EQ(faces.size(), 12u);
-  EXPECT_TRUE(faces.count({1, 2, s1}) && faces.count({2, 3, s1}));
-  EXPECT_FALSE(faces.count({1, 3, s1}));
-  // The line's edges now have a face on each side: the strip's only boundary is its outline.
-  const TopologyStats topo = ComputeTopology(out);
-  EXPECT_EQ(topo.boundary_edges, 8u);  // 0, s0, s1, s2, 4, t2, t1, t0
-  EXPECT_EQ(topo.euler, 1);
-}
-
 TEST(ThinMesh, ATriangularHoleIsClosedButNotTheOutline) {
   const auto udf = MakeShape("disc");
   TriangleMesh m;
@@ -302,25 +271,6 @@ TEST(ThinMesh, AFaceOverACrackAtABranchingLineIsSplit) {
   ExpectGridWithWholeFin(out);
 }
 
-TEST(ThinMesh, AFoldAtAnOpenRimBecomesBoundary) {
-  const auto udf = MakeShape("disc");
-  TriangleMesh m;
-  AddGrid(m, 6, 6);  // vertex (i, j) is j * 7 + i; row j = 0 is the rim y = -0.3
-  // Cell (2, 0) is covered twice: by its two faces and by a fan around an inner point p. Its inner edges are
-  // then non-manifold and the rim edge 2-3 has two faces on the same (inner) side. Whichever cover goes,
-  // 2-3 is left with one face: a boundary edge, which at the rim is right, so only the rim pass may do it.
-  const int p = AddVertex(m, {-0.05, -0.26, 0.0});
-  const int v20 = 2, v30 = 3, v31 = 10, v21 = 9;
-  for (const Tri& t : std::vector<Tri>{{v20, v30, p}, {v30, v31, p}, {v31, v21, p}, {v21, v20, p}}) m.faces.push_back(t);
-  ThinMeshStats stats;
-  const TriangleMesh out = ThinMesh(*udf, m, ThinMeshOptions{}, Monitor::Null(), &stats);
-  EXPECT_EQ(stats.rim_folds_opened, 1u);
-  const TopologyStats topo = ComputeTopology(out);
-  EXPECT_EQ(topo.nonmanifold_edges, 0u);
-  EXPECT_EQ(topo.boundary_edges, 24u);
-  EXPECT_EQ(topo.euler, 1);
-}
-
 TEST(ThinMesh, ManifoldComponentsAreOrientedConsistently) {
   const auto udf = MakeShape("disc");
   TriangleMesh m;
@@ -346,43 +296,16 @@ TEST(ThinMesh, NonManifoldEdgesAreExtracted) {
   EXPECT_EQ(nm.vertices[1], m.vertices[1]);
 }
 
-/// A flat fan on edge 0-1 with a third face 0-1-4 on the same side as 0-1-2 (a fold), or, when `fin`, with
-/// vertex 4 lifted out of the plane (a branching of the surface).
-TriangleMesh Fold(bool fin) {
-  TriangleMesh m;
-  m.vertices = {{0, 0, 0}, {0.2, 0, 0}, {0.1, 0.2, 0}, {0.1, -0.2, 0}, {0.1, fin ? 0.0 : 0.08, fin ? 0.2 : 0.0}};
-  m.faces = {{0, 1, 2}, {1, 0, 3}, {0, 1, 4}};
-  return m;
-}
-
-TEST(ThinMesh, AFlatFoldIsRetriangulatedWithoutOpeningTheSurface) {
-  ThinMeshStats st;
-  const TriangleMesh out = ThinMesh(*MakeShape("disc"), Fold(false), MinFaces(0), Monitor::Null(), &st);
-  EXPECT_EQ(st.folds_retriangulated, 1u);
-  const TopologyStats topo = ComputeTopology(out);
-  EXPECT_EQ(topo.nonmanifold_edges, 0u);
-  EXPECT_EQ(topo.boundary_edges, 4u);  // the fan's outline 0-2-1-3
-  EXPECT_EQ(topo.euler, 1);
-  EXPECT_EQ(out.faces.size(), 4u);  // vertex 4 is now inside the fan: 0-1-4, 0-4-2, 4-1-2 and 0-1-3
-}
-
-TEST(ThinMesh, ABranchingEdgeIsNotAFold) {
-  ThinMeshStats st;
-  const TriangleMesh out = ThinMesh(*MakeShape("disc"), Fold(true), MinFaces(0), Monitor::Null(), &st);
-  EXPECT_EQ(st.folds_retriangulated, 0u);
-  EXPECT_EQ(ComputeTopology(out).nonmanifold_edges, 1u);
-  ThinMeshOptions off = MinFaces(0);
-  off.fold_flatness_deg = 0;
-  EXPECT_EQ(ComputeTopology(ThinMesh(*MakeShape("disc"), Fold(false), off, Monitor::Null())).nonmanifold_edges, 1u);
-}
-
 TEST(ThinMesh, BadOptionsAreUsageErrors) {
   ThinMeshOptions o;
   o.degenerate_quality = -1;
   EXPECT_THROW(o.Check(), UsageError);
   ThinMeshOptions f;
-  f.fold_flatness_deg = 90;
+  f.overlap_angle_deg = 90;
   EXPECT_THROW(f.Check(), UsageError);
+  ThinMeshOptions t;
+  t.thinning = "repair";
+  EXPECT_THROW(t.Check(), UsageError);
 }
 
 class ThinMeshExe : public ::testing::Test {

@@ -1,7 +1,8 @@
 #include "stages/build-gvd/build_gvd.h"
 
-#include <flann/flann.hpp>
 #include <omp.h>
+
+#include <Eigen/Eigenvalues>
 
 #include <algorithm>
 #include <cstdarg>
@@ -16,6 +17,7 @@
 #include <utility>
 
 #include "common/errors.h"
+#include "common/knn.h"
 #include "common/mesh_topology.h"
 #include "common/morton.h"
 #include "common/projection.h"
@@ -35,51 +37,34 @@ std::string Format(const char* fmt, ...) {
   return buf;
 }
 
-/// Exact k nearest neighbours of every point among `points` (itself excluded), k' = min(k, n-1) per point,
-/// in increasing distance (FLANN's single kd-tree: exact, and its answers do not depend on the threads).
-/// Returns a row-major n x k' table.
-std::vector<int> KNearest(const std::vector<Vec3>& points, int k, int* k_out, Monitor& monitor,
-                          const std::string& task_name) {
-  const size_t n = points.size();
-  const int kk = static_cast<int>(std::min<size_t>(static_cast<size_t>(k), n > 0 ? n - 1 : 0));
-  *k_out = kk;
-  std::vector<int> result(n * static_cast<size_t>(kk), -1);
-  if (kk == 0) return result;
-  // FLANN wants a contiguous row-major matrix; Vec3 is three packed doubles.
-  std::vector<double> flat(3 * n);
-  for (size_t i = 0; i < n; ++i)
-    for (int c = 0; c < 3; ++c) flat[3 * i + c] = points[i][c];
-  flann::Matrix<double> data(flat.data(), n, 3);
-  flann::Index<flann::L2_Simple<double>> index(data, flann::KDTreeSingleIndexParams(12));
-  index.buildIndex();
-
-  // Chunks bound the memory of FLANN's result matrices; k + 1 because every point finds itself.
-  const size_t chunk = 32768;
-  const int kq = kk + 1;
-  std::vector<size_t> idx(chunk * static_cast<size_t>(kq));
-  std::vector<double> dist(chunk * static_cast<size_t>(kq));
-  flann::SearchParams params(flann::FLANN_CHECKS_UNLIMITED);
-  params.cores = omp_get_max_threads();
-  params.sorted = true;
-  Task task(monitor, task_name, n);
-  for (size_t begin = 0; begin < n; begin += chunk) {
-    const size_t m = std::min(chunk, n - begin);
-    flann::Matrix<double> queries(flat.data() + 3 * begin, m, 3);
-    flann::Matrix<size_t> mi(idx.data(), m, static_cast<size_t>(kq));
-    flann::Matrix<double> md(dist.data(), m, static_cast<size_t>(kq));
-    index.knnSearch(queries, mi, md, static_cast<size_t>(kq), params);
-    for (size_t q = 0; q < m; ++q) {
-      const size_t self = begin + q;
-      int filled = 0;
-      for (int j = 0; j < kq && filled < kk; ++j) {
-        const size_t other = mi[q][j];
-        if (other == self || other >= n) continue;
-        result[self * static_cast<size_t>(kk) + static_cast<size_t>(filled++)] = static_cast<int>(other);
-      }
-    }
-    task.Advance(m);
+// The surface normal of every seed's Voronoi region, from the principal axes of its samples (the axis of
+// least spread), and whether the region is a sheet: its least spread at most `flatness` x its largest.
+// A region across a crease, around a corner or along a branching curve is no sheet and gets no normal.
+// Geometric on purpose: a seed's own UDF gradient is undefined where it sits on the zero set, and on an
+// open rim or a crease it is one side's (or in-plane, pointing away from the rim).
+void RegionNormals(const std::vector<Vec3>& node, const std::vector<int>& label, size_t num_seeds, double flatness,
+                   std::vector<Vec3>* normal, std::vector<uint8_t>* on_sheet) {
+  std::vector<Vec3> sum(num_seeds, Vec3::Zero());
+  std::vector<Eigen::Matrix3d> outer(num_seeds, Eigen::Matrix3d::Zero());
+  std::vector<size_t> count(num_seeds, 0);
+  for (size_t u = 0; u < node.size(); ++u) {
+    if (label[u] < 0) continue;
+    const size_t s = static_cast<size_t>(label[u]);
+    sum[s] += node[u];
+    outer[s] += node[u] * node[u].transpose();
+    ++count[s];
   }
-  return result;
+  normal->assign(num_seeds, Vec3::Zero());
+  on_sheet->assign(num_seeds, 0);
+  for (size_t s = 0; s < num_seeds; ++s) {
+    if (count[s] < 4) continue;
+    const double m = static_cast<double>(count[s]);
+    const Vec3 mean = sum[s] / m;
+    const Eigen::Matrix3d cov = outer[s] / m - mean * mean.transpose();
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(cov);
+    (*normal)[s] = eig.eigenvectors().col(0);
+    (*on_sheet)[s] = eig.eigenvalues()(0) <= flatness * flatness * eig.eigenvalues()(2);
+  }
 }
 
 }  // namespace
@@ -110,7 +95,7 @@ GvdResult BuildGvd(const Udf& udf, const SeedCloud& seeds, const BuildGvdOptions
   // 1. Dense samples. Ball radius per seed: the distance to its 6th-nearest seed (one ring of neighbours
   // on a sheet), so the balls overlap and adapt to the local seed density; capped for isolated seeds.
   int k_seeds = 0;
-  const std::vector<int> seed_nn = KNearest(seeds.position, 6, &k_seeds, Monitor::Null(), "seed neighbours");
+  const std::vector<int> seed_nn = KNearestAmong(seeds.position, 6, &k_seeds, Monitor::Null(), "seed neighbours");
   std::vector<double> radius(num_seeds, 0.05 * diag);
   for (size_t i = 0; i < num_seeds && k_seeds > 0; ++i) {
     const int far = seed_nn[i * static_cast<size_t>(k_seeds) + static_cast<size_t>(k_seeds - 1)];
@@ -201,7 +186,7 @@ GvdResult BuildGvd(const Udf& udf, const SeedCloud& seeds, const BuildGvdOptions
   // 3. kNN graph, undirected, pruned.
   monitor.Debug("node gradients evaluated");
   int kk = 0;
-  const std::vector<int> knn = KNearest(node, options.knn, &kk, monitor, "kNN graph");
+  const std::vector<int> knn = KNearestAmong(node, options.knn, &kk, monitor, "kNN graph");
   monitor.Debug("kNN queries done");
   // Undirected edges, each once: (i, j) from i's list when j > i, or when i is not in j's list. No global
   // sort (it took longer than the queries); the order is by i, then by distance, whatever the threads.
@@ -357,28 +342,6 @@ GvdResult BuildGvd(const Udf& udf, const SeedCloud& seeds, const BuildGvdOptions
       }
       std::sort(others.begin(), others.end());
       others.erase(std::unique(others.begin(), others.end()), others.end());
-      if (options.witness == "clique") {
-        // Only graph triangles (u, v, w) with three labels witness a junction: the three regions meet
-        // there, not just within u's neighbourhood.
-        if (others.size() < 2) continue;
-        for (size_t a = offset[u]; a < offset[u + 1]; ++a) {
-          const size_t v = static_cast<size_t>(adj[a]);
-          const int j = label[v];
-          if (j < 0 || j == i || v < u) continue;
-          for (size_t b = a + 1; b < offset[u + 1]; ++b) {
-            const size_t w = static_cast<size_t>(adj[b]);
-            const int k = label[w];
-            if (k < 0 || k == i || k == j || w < u) continue;
-            if (!std::binary_search(adj.begin() + static_cast<long>(offset[v]), adj.begin() + static_cast<long>(offset[v + 1]),
-                                    static_cast<int>(w)))
-              continue;
-            Tri t{i, j, k};
-            std::sort(t.begin(), t.end());
-            out.push_back(t);
-          }
-        }
-        continue;
-      }
       for (size_t p = 0; p < others.size(); ++p)
         for (size_t q = p + 1; q < others.size(); ++q) {
           Tri t{i, others[p], others[q]};
@@ -393,56 +356,18 @@ GvdResult BuildGvd(const Udf& udf, const SeedCloud& seeds, const BuildGvdOptions
   faces.erase(std::unique(faces.begin(), faces.end()), faces.end());
   if (options.dual == "delaunay") {
     RestrictedDualStats rd;
-    std::vector<Vec3> seed_normal(num_seeds, Vec3::Zero());
-    for (size_t u = 0; u < n; ++u)
-      if (node_seed[u] >= 0) seed_normal[static_cast<size_t>(node_seed[u])] = node_n[u];
-    std::vector<uint8_t> on_sheet(num_seeds);
-    for (size_t i = 0; i < num_seeds; ++i) on_sheet[i] = seeds.rank[i] <= kRankSheet;
-    // Border lengths: the graph edges between differently labelled nodes, per pair of labels.
-    std::unordered_map<uint64_t, size_t> border;
-    for (size_t u = 0; u < n && options.open_by_border; ++u)
-      for (size_t a = offset[u]; a < offset[u + 1]; ++a) {
-        const size_t v = static_cast<size_t>(adj[a]);
-        if (v <= u || label[u] < 0 || label[v] < 0 || label[u] == label[v]) continue;
-        ++border[EdgeKey(MakeEdge(label[u], label[v]))];
-      }
-    faces = LocallyDelaunayTriples(seeds.position, seed_normal, on_sheet, faces, border, options.chart_angle_deg, &rd);
-    monitor.Info(Format("locally Delaunay: %zu of %zu witnessed triples kept (%zu collinear; %zu tetrahedra opened "
-                        "on their weakest border)", rd.kept, rd.witnessed, rd.degenerate, rd.tetrahedra_opened));
-  }
-  // 6. Junctions the samples skipped. Around a region, the neighbouring region can change from j to k along a
-  // path of samples none of which sees i, j and k at once (the random samples leave a gap right at the
-  // junction); the three borders then each get one triangle fewer than they should, and the mesh a triangular
-  // hole. Such a junction shows as three thick-mesh edges of one face each that form a cycle: add its triangle.
-  if (options.close_skipped_junctions) {
-    const EdgeFaces ef = BuildEdgeFaces(faces);
-    std::unordered_map<int, std::vector<int>> open;  // vertex -> other ends of its single-face edges
-    for (size_t e = 0; e < ef.edges.size(); ++e)
-      if (ef.faces[e].size() == 1) {
-        open[ef.edges[e][0]].push_back(ef.edges[e][1]);
-        open[ef.edges[e][1]].push_back(ef.edges[e][0]);
-      }
-    std::vector<Tri> added;
-    for (size_t e = 0; e < ef.edges.size(); ++e) {
-      if (ef.faces[e].size() != 1) continue;
-      const int a = ef.edges[e][0], b = ef.edges[e][1];
-      std::vector<int> na = open[a], nb = open[b];
-      std::sort(na.begin(), na.end());
-      std::sort(nb.begin(), nb.end());
-      std::vector<int> common;
-      std::set_intersection(na.begin(), na.end(), nb.begin(), nb.end(), std::back_inserter(common));
-      for (int c : common)
-        if (c > b) added.push_back({a, b, c});
-    }
-    stats.junctions_closed = added.size();
-    faces.insert(faces.end(), added.begin(), added.end());
-    std::sort(faces.begin(), faces.end());
-    faces.erase(std::unique(faces.begin(), faces.end()), faces.end());
+    std::vector<Vec3> seed_normal;
+    std::vector<uint8_t> on_sheet;
+    RegionNormals(node, label, num_seeds, options.region_flatness, &seed_normal, &on_sheet);
+    // A seed optimize-seeds put on a feature (rank 2 or 3) has no say either, even with a flat region.
+    for (size_t i = 0; i < num_seeds; ++i) on_sheet[i] = on_sheet[i] && seeds.rank[i] <= kRankSheet;
+    faces = LocallyDelaunayTriples(seeds.position, seed_normal, on_sheet, faces, options.chart_angle_deg, &rd);
+    monitor.Info(Format("locally Delaunay: %zu of %zu witnessed triples kept (%zu collinear)", rd.kept, rd.witnessed,
+                        rd.degenerate));
   }
   stats.triangles = faces.size();
   result.thick.vertices = seeds.position;
-  monitor.Info(Format("%zu dual triangles over %zu seeds (%zu closing junctions the samples skipped)", faces.size(),
-                      num_seeds, stats.junctions_closed));
+  monitor.Info(Format("%zu dual triangles over %zu seeds", faces.size(), num_seeds));
   if (faces.empty())
     throw NumericalError("no dual triangle: the Voronoi regions of the seeds never meet three at a time (too few "
                          "seeds, or the graph is pruned apart: check --eps-udf-rel and --eps-grad)");

@@ -33,20 +33,15 @@ struct BuildGvdOptions {
   double eps_udf_rel = 2e-3;
   /// An edge is pruned when |cos(edge, gradient)| at either endpoint exceeds this (--eps-grad).
   double eps_grad = 0.97;
-  /// Adds the triangle of three single-face thick-mesh edges that form a cycle: a junction of three regions
-  /// that no sample saw (--close-skipped-junctions; BuildGvd step 6).
-  bool close_skipped_junctions = true;
-  /// --dual: "delaunay", the witnessed triples that are facets of the seeds' 3-D Delaunay triangulation
-  /// (restricted_dual.h); "paper", every witnessed triple (the thick dual of the paper).
-  std::string dual = "paper";
-  /// --witness: "wide", a node of label i with graph neighbours of labels j and k witnesses (i, j, k) (the
-  /// paper); "clique", only a graph triangle whose three nodes carry i, j and k does.
-  std::string witness = "wide";
+  /// --dual: "delaunay", the witnessed triples that are locally Delaunay (restricted_dual.h: one
+  /// triangulation per junction); "paper", every witnessed triple (the paper's thick dual).
+  std::string dual = "delaunay";
   /// --chart-angle: with --dual delaunay, the four seeds of a junction share a chart (their tangent plane
   /// decides which triangles it keeps) when their normals agree within this angle, degrees.
   double chart_angle_deg = 25.0;
-  /// --open-by-border: tetrahedra no chart decides lose the two triples on their weakest Voronoi border.
-  bool open_by_border = true;
+  /// --region-flatness: with --dual delaunay, a seed's region is a sheet (its normal counts for charts) when
+  /// its samples' least spread is at most this x their largest.
+  double region_flatness = 0.15;
   uint64_t seed = 0;           ///< RNG seed of the dense samples (--seed)
   double proj_tol_rel = 1e-5;  ///< samples converge once d < proj_tol_rel * diagonal (--proj-tol-rel)
   int proj_max_iters = 50;     ///< projection steps before a sample is dropped (--proj-max-iters)
@@ -66,7 +61,6 @@ struct BuildGvdStats {
   size_t edges_pruned_udf = 0;    ///< of those, pruned by the midpoint UDF test
   size_t edges_pruned_grad = 0;   ///< pruned by the gradient test (and not by the UDF test)
   size_t unreached = 0;           ///< nodes no seed reaches (label -1)
-  size_t junctions_closed = 0;    ///< triangles added by step 6
   size_t triangles = 0;
 };
 

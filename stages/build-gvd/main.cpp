@@ -26,13 +26,12 @@ int main(int argc, char** argv) {
   app.add_option("--knn", options.knn, "neighbours per sample in the kNN graph");
   app.add_option("--eps-udf-rel", options.eps_udf_rel, "prune edges with midpoint UDF above this x diagonal");
   app.add_option("--eps-grad", options.eps_grad, "prune edges with |cos(edge, gradient)| above this at an end");
-  app.add_option("--close-skipped-junctions", options.close_skipped_junctions,
-                 "add the triangle of 3 single-face edges forming a cycle (a junction no sample saw)");
-  app.add_option("--dual", options.dual, "delaunay: witnessed triples that are Delaunay facets; paper: all witnessed")
+  app.add_option("--dual", options.dual,
+                 "delaunay: the witnessed triples that are locally Delaunay (one triangulation per junction); "
+                 "paper: every witnessed triple (the paper's thick dual)")
       ->check(CLI::IsMember({"delaunay", "paper"}));
-  app.add_option("--witness", options.witness, "wide: a node and two neighbours of other labels; clique: a graph triangle")
-      ->check(CLI::IsMember({"wide", "clique"}));
-  app.add_option("--open-by-border", options.open_by_border, "with --dual delaunay: tetrahedra no chart decides lose the triples on their weakest border");
+  app.add_option("--region-flatness", options.region_flatness,
+                 "with --dual delaunay: a region flatter than this (least / largest spread) is a sheet");
   app.add_option("--chart-angle", options.chart_angle_deg,
                  "with --dual delaunay: seeds whose normals agree within this angle (deg) share a chart");
   app.add_option("--proj-tol-rel", options.proj_tol_rel, "projection tolerance on d, relative to the diagonal");

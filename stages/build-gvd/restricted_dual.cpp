@@ -7,9 +7,6 @@
 #include <cmath>
 #include <cstdint>
 #include <iterator>
-#include <unordered_map>
-
-#include "common/mesh_topology.h"
 
 namespace voroudf {
 namespace {
@@ -50,16 +47,11 @@ Vec3 ChartNormal(const std::array<int, 4>& id, const std::vector<Vec3>& seeds, c
   return plane;
 }
 
-uint64_t TriangleKey(const Tri& t) {
-  return (static_cast<uint64_t>(t[0]) << 42) ^ (static_cast<uint64_t>(t[1]) << 21) ^ static_cast<uint64_t>(t[2]);
-}
-
 }  // namespace
 
 std::vector<Tri> LocallyDelaunayTriples(const std::vector<Vec3>& seeds, const std::vector<Vec3>& normals,
                                         const std::vector<uint8_t>& on_sheet, const std::vector<Tri>& witnessed,
-                                        const std::unordered_map<uint64_t, size_t>& border, double chart_angle_deg,
-                                        RestrictedDualStats* stats_out) {
+                                        double chart_angle_deg, RestrictedDualStats* stats_out) {
   RestrictedDualStats stats;
   stats.witnessed = witnessed.size();
   // Geodesic neighbours: the seeds each seed shares a witnessed triple with.
@@ -103,60 +95,6 @@ std::vector<Tri> LocallyDelaunayTriples(const std::vector<Vec3>& seeds, const st
       }
     }
     if (!blocked) kept.push_back(t);
-  }
-  // Junctions no chart decides (across a crease, at a branching curve): of four seeds whose four triples
-  // all survive, the two regions that barely touch are the pair with the shortest border. The two triples
-  // on that edge go, weakest border first; a tetrahedron already opened is skipped.
-  if (!border.empty()) {
-    std::unordered_map<uint64_t, size_t> index;
-    for (size_t f = 0; f < kept.size(); ++f) index[TriangleKey(kept[f])] = f;
-    struct Candidate {
-      size_t border;
-      Edge edge;
-      std::array<int, 4> seeds;
-    };
-    std::vector<Candidate> tets;
-    for (const Tri& t : kept) {
-      for (int v : neighbours[static_cast<size_t>(t[0])]) {
-        if (v <= t[2]) continue;  // each tetrahedron once: from its face of the three smallest seeds
-        const Tri others[3] = {{t[0], t[1], v}, {t[0], t[2], v}, {t[1], t[2], v}};
-        if (!index.count(TriangleKey(others[0])) || !index.count(TriangleKey(others[1])) ||
-            !index.count(TriangleKey(others[2])))
-          continue;
-        const std::array<int, 4> q{t[0], t[1], t[2], v};
-        Candidate best{SIZE_MAX, {0, 0}, q};
-        for (int a = 0; a < 4; ++a)
-          for (int b = a + 1; b < 4; ++b) {
-            const Edge e = MakeEdge(q[a], q[b]);
-            const auto it = border.find(EdgeKey(e));
-            const size_t strength = it == border.end() ? 0 : it->second;
-            if (strength < best.border || (strength == best.border && e < best.edge)) best.border = strength, best.edge = e;
-          }
-        tets.push_back(best);
-      }
-    }
-    std::sort(tets.begin(), tets.end(), [](const Candidate& x, const Candidate& y) {
-      return x.border != y.border ? x.border < y.border : x.seeds < y.seeds;
-    });
-    std::vector<char> gone(kept.size(), 0);
-    auto alive = [&](const Tri& t) {
-      const auto it = index.find(TriangleKey(t));
-      return it != index.end() && !gone[it->second];
-    };
-    for (const Candidate& c : tets) {
-      const auto& q = c.seeds;
-      const Tri faces[4] = {{q[0], q[1], q[2]}, {q[0], q[1], q[3]}, {q[0], q[2], q[3]}, {q[1], q[2], q[3]}};
-      if (!alive(faces[0]) || !alive(faces[1]) || !alive(faces[2]) || !alive(faces[3])) continue;
-      for (const Tri& f : faces)
-        if ((f[0] == c.edge[0] || f[1] == c.edge[0] || f[2] == c.edge[0]) &&
-            (f[0] == c.edge[1] || f[1] == c.edge[1] || f[2] == c.edge[1]))
-          gone[index[TriangleKey(f)]] = 1;
-      ++stats.tetrahedra_opened;
-    }
-    std::vector<Tri> left;
-    for (size_t f = 0; f < kept.size(); ++f)
-      if (!gone[f]) left.push_back(kept[f]);
-    kept.swap(left);
   }
   stats.kept = kept.size();
   if (stats_out) *stats_out = stats;

@@ -3,7 +3,6 @@
 // junction's samples see (docs/build-gvd.md, "The dual").
 #include <cstddef>
 #include <cstdint>
-#include <unordered_map>
 #include <vector>
 
 #include "common/types.h"
@@ -14,7 +13,6 @@ struct RestrictedDualStats {
   size_t witnessed = 0;     ///< witnessed triples given
   size_t kept = 0;          ///< of those, locally Delaunay (kept)
   size_t degenerate = 0;    ///< of those, collinear seeds (no circumsphere): dropped
-  size_t tetrahedra_opened = 0;  ///< four seeds no chart decided: the two triples on their weakest border dropped
 };
 
 /// The locally Delaunay witnessed triples. A witnessed triple (i, j, k) — three seeds whose geodesic
@@ -39,12 +37,9 @@ struct RestrictedDualStats {
 /// \param normals    a unit surface normal (UDF gradient) per seed, either orientation; zero: no chart
 /// \param on_sheet   per seed, whether it lies on a sheet (rank 1 or unknown): only those normals count
 /// \param witnessed  triples of seed indices, each vertex triple once, indices sorted
-/// \param border     per pair of seeds (EdgeKey of MakeEdge), the graph edges between their regions: the
-///                   length of their Voronoi border; empty: no tetrahedron is opened by it
 /// \returns the kept triples in the order given (collinear triples are dropped)
 std::vector<Tri> LocallyDelaunayTriples(const std::vector<Vec3>& seeds, const std::vector<Vec3>& normals,
                                         const std::vector<uint8_t>& on_sheet, const std::vector<Tri>& witnessed,
-                                        const std::unordered_map<uint64_t, size_t>& border, double chart_angle_deg,
-                                        RestrictedDualStats* stats);
+                                        double chart_angle_deg, RestrictedDualStats* stats);
 
 }  // namespace voroudf

@@ -1,6 +1,5 @@
 #include "stages/evaluate/evaluate.h"
 
-#include <flann/flann.hpp>
 #include <omp.h>
 
 #include <algorithm>
@@ -13,6 +12,7 @@
 #include <unordered_map>
 #include <utility>
 
+#include "common/knn.h"
 #include "common/morton.h"
 #include "common/errors.h"
 #include "common/rng.h"
@@ -21,8 +21,6 @@
 namespace voroudf {
 namespace {
 
-// Queries go to FLANN in blocks so that progress can be reported between them.
-constexpr size_t kQueryBlock = 16384;
 // Exact-distance queries: blocks of consecutive Morton-ordered points, one hint chain per block.
 constexpr size_t kBvhBlock = 4096;
 
@@ -31,23 +29,6 @@ constexpr size_t kBvhBlock = 4096;
 constexpr uint64_t kRefStream = 0;
 constexpr uint64_t kMeshStream = 1ull << 40;
 
-using KdIndex = flann::Index<flann::L2_Simple<double>>;
-
-// flann::Matrix only points at memory it does not own: the rows live as long as the index.
-struct KdTree {
-  std::vector<double> rows;
-  std::unique_ptr<KdIndex> index;
-
-  explicit KdTree(const std::vector<Vec3>& points) : rows(3 * points.size()) {
-    for (size_t i = 0; i < points.size(); ++i)
-      for (int k = 0; k < 3; ++k) rows[3 * i + k] = points[i][k];
-    // Single kd-tree with exact search: randomised forests would make results depend on rand().
-    index = std::make_unique<KdIndex>(flann::Matrix<double>(rows.data(), points.size(), 3),
-                                      flann::KDTreeSingleIndexParams(10));
-    index->buildIndex();
-  }
-};
-
 using Cell = std::array<long long, 3>;
 struct CellHash {
   size_t operator()(const Cell& c) const {
@@ -55,20 +36,6 @@ struct CellHash {
                                                                                  SplitMix64(static_cast<uint64_t>(c[2])))));
   }
 };
-
-flann::SearchParams ExactSearch() {
-  flann::SearchParams params(flann::FLANN_CHECKS_UNLIMITED, 0.0f, false);
-  params.cores = omp_get_max_threads();
-  return params;
-}
-
-std::vector<double> QueryRows(const std::vector<Vec3>& points, const std::vector<size_t>& order, size_t begin,
-                              size_t end) {
-  std::vector<double> q(3 * (end - begin));
-  for (size_t i = begin; i < end; ++i)
-    for (int k = 0; k < 3; ++k) q[3 * (i - begin) + k] = points[order[i]][k];
-  return q;
-}
 
 void CheckFaceIndices(const TriangleMesh& mesh, const std::string& what) {
   const long long nv = static_cast<long long>(mesh.vertices.size());
@@ -198,21 +165,8 @@ SurfaceSamples SampleSurface(const TriangleMesh& mesh, size_t count, uint64_t se
 std::vector<double> NearestDistances(const std::vector<Vec3>& from, const std::vector<Vec3>& to, Monitor& monitor) {
   std::vector<double> distance(from.size());
   if (from.empty()) return distance;
-  const KdTree tree(to);
-  const flann::SearchParams params = ExactSearch();
-  const std::vector<size_t> order = MortonOrder(from, BoundingBox(from));
-  for (size_t begin = 0; begin < from.size(); begin += kQueryBlock) {
-    const size_t end = std::min(from.size(), begin + kQueryBlock);
-    std::vector<double> q = QueryRows(from, order, begin, end);
-    std::vector<int> index(end - begin);
-    std::vector<double> dist2(end - begin);
-    flann::Matrix<double> queries(q.data(), end - begin, 3);
-    flann::Matrix<int> indices(index.data(), end - begin, 1);
-    flann::Matrix<double> dists(dist2.data(), end - begin, 1);
-    tree.index->knnSearch(queries, indices, dists, 1, params);
-    for (size_t i = begin; i < end; ++i) distance[order[i]] = (from[order[i]] - to[index[i - begin]]).norm();
-    monitor.Advance(end - begin);
-  }
+  const std::vector<int> nearest = NearestIndices(to, from, monitor);
+  for (size_t i = 0; i < from.size(); ++i) distance[i] = (from[i] - to[static_cast<size_t>(nearest[i])]).norm();
   return distance;
 }
 

@@ -9,8 +9,9 @@ int main(int argc, char** argv) {
   bool ascii = false;
 
   voroudf::StageCli cli("thin-mesh",
-                        "Removes face pairs from the closed tetrahedra of a thick mesh (the pair on a manifold edge "
-                        "whose centroids have the highest UDF), then small components; keeps non-manifold edges.");
+                        "Removes face pairs from the closed tetrahedra of a dual mesh (the pair on a manifold edge "
+                        "whose centroids have the highest UDF), then small components, then closes the gaps of "
+                        "junctions the dual missed; keeps non-manifold edges.");
   cli.AddUdf(&udf_spec);
   cli.AddInput(&input, "input thick mesh PLY (thick.ply from build-gvd)");
   cli.AddOutput(&output, "output mesh PLY (mesh.ply)");
@@ -21,11 +22,11 @@ int main(int argc, char** argv) {
                  "components with fewer faces are removed (unless that opens a hole)");
   app.add_option("--degenerate-quality", options.degenerate_quality,
                  "faces with triangle quality below this are dropped as degenerate (0: only zero area)");
-  app.add_option("--fold-flatness", options.fold_flatness_deg,
-                 "re-triangulate faces around a non-manifold edge within this angle (deg) of a plane (0: off)");
-  app.add_option("--thinning", options.thinning, "paper: only the paper's steps; repair: also steps 0b, 4-6")
-      ->check(CLI::IsMember({"paper", "repair"}));
-  app.add_option("--repairs", options.repairs, "with --thinning repair: which of split,folds,holes,rims run");
+  app.add_option("--thinning", options.thinning,
+                 "paper: the paper's two steps only; close-holes: then close the junction gaps the dual left")
+      ->check(CLI::IsMember({"paper", "close-holes"}));
+  app.add_option("--overlap-angle", options.overlap_angle_deg,
+                 "a face added to close a gap must not lie within this angle (deg) of a face on its edges");
 
   return cli.Run(argc, argv, [&] { options.Check(); }, [&](voroudf::Monitor& monitor) {
     const auto udf = cli.OpenUdf(monitor);
