@@ -80,19 +80,13 @@ void BuildGvdOptions::Check() const {
   if (proj_max_iters < 1) throw UsageError("--proj-max-iters must be at least 1");
 }
 
-GvdResult BuildGvd(const Udf& udf, const SeedCloud& seeds, const BuildGvdOptions& options, bool with_graph,
-                   Monitor& monitor) {
-  options.Check();
-  const size_t num_seeds = seeds.size();
-  if (num_seeds == 0) throw InputError("the seeds file has no seeds");
-  if (num_seeds > static_cast<size_t>(std::numeric_limits<int>::max() / 4))
-    throw InputError("too many seeds for 32-bit mesh indices");
-  const Box box = udf.Domain();
-  const double diag = box.Diagonal();
-  GvdResult result;
-  BuildGvdStats& stats = result.stats;
+namespace {
 
-  // 1. Dense samples. Ball radius per seed: the distance to its 6th-nearest seed (one ring of neighbours
+// Step 1: the dense samples before projection, the first `*in_space` of them uniform in the box.
+std::vector<Vec3> DrawSamples(const SeedCloud& seeds, const Box& box, const BuildGvdOptions& options, size_t* in_space_out) {
+  const size_t num_seeds = seeds.size();
+  const double diag = box.Diagonal();
+  // Ball radius per seed: the distance to its 6th-nearest seed (one ring of neighbours
   // on a sheet), so the balls overlap and adapt to the local seed density; capped for isolated seeds.
   int k_seeds = 0;
   const std::vector<int> seed_nn = KNearestAmong(seeds.position, 6, &k_seeds, Monitor::Null(), "seed neighbours");
@@ -134,14 +128,16 @@ GvdResult BuildGvd(const Udf& udf, const SeedCloud& seeds, const BuildGvdOptions
     } while (u.squaredNorm() > 1.0);
     samples[i] = seeds.position[s] + radius[s] * u;
   }
-  stats.samples_drawn = total;
-  ProjectionOptions proj;
-  proj.tolerance = options.proj_tol_rel * diag;
-  proj.max_iterations = options.proj_max_iters;
-  const ProjectionResult projected = ProjectToZeroSet(udf, samples, proj, monitor);
-  stats.samples_projected = projected.num_converged;
+  *in_space_out = in_space;
+  return samples;
+}
 
-  // 2. Nodes: seeds first (so that they win Morton-cell ties), then converged samples.
+// Step 2: the graph nodes, seeds first (so that they win Morton-cell ties), then converged samples, sorted
+// along a Morton curve; a node in the Morton cell of an earlier one is dropped. node_seed: the seed index of
+// a seed node, -1 for a sample.
+void MakeNodes(const SeedCloud& seeds, const std::vector<Vec3>& samples, const ProjectionResult& projected,
+               const Box& box, BuildGvdStats& stats, std::vector<Vec3>* node_out, std::vector<int>* node_seed_out) {
+  const size_t num_seeds = seeds.size(), total = samples.size();
   std::vector<Vec3> raw;
   raw.reserve(num_seeds + projected.num_converged);
   raw.insert(raw.end(), seeds.position.begin(), seeds.position.end());
@@ -168,22 +164,23 @@ GvdResult BuildGvd(const Udf& udf, const SeedCloud& seeds, const BuildGvdOptions
     node.push_back(raw[r]);
     node_seed.push_back(is_seed ? static_cast<int>(r) : -1);
   }
+  *node_out = std::move(node);
+  *node_seed_out = std::move(node_seed);
+}
+
+// Step 3: the kNN graph (k = options.knn), undirected, with the edges that leave the surface or jump
+// between sheets pruned; the kept edges as sorted adjacency lists (CSR).
+struct Graph {
+  std::vector<std::pair<int, int>> edges;  // every undirected kNN edge once
+  std::vector<char> keep;                  // per edge: survived the pruning
+  std::vector<size_t> offset;              // CSR: node i's neighbours are adj[offset[i] .. offset[i + 1])
+  std::vector<int> adj;
+};
+
+Graph PrunedGraph(const Udf& udf, const std::vector<Vec3>& node, const std::vector<double>& node_d,
+                  const std::vector<Vec3>& node_n, const BuildGvdOptions& options, double diag, BuildGvdStats& stats,
+                  Monitor& monitor) {
   const size_t n = node.size();
-  stats.nodes = n;
-  if (stats.seeds_duplicate > 0)
-    monitor.Warn(Format("%zu seeds coincide with an earlier seed (same 2^-21 Morton cell) and are left out",
-                        stats.seeds_duplicate));
-  monitor.Info(Format("%zu dense samples drawn (%zu in the box, %zu around seeds), %zu on the zero set, "
-                      "%zu duplicates dropped; graph of %zu nodes (%zu seeds)",
-                      total, in_space, total - in_space, stats.samples_projected, stats.samples_duplicate, n,
-                      num_seeds - stats.seeds_duplicate));
-
-  // Gradients at the nodes (on the zero set this is a surface normal of either orientation).
-  std::vector<double> node_d;
-  std::vector<Vec3> node_n;
-  udf.Evaluate(node, node_d, node_n);
-
-  // 3. kNN graph, undirected, pruned.
   monitor.Debug("node gradients evaluated");
   int kk = 0;
   const std::vector<int> knn = KNearestAmong(node, options.knn, &kk, monitor, "kNN graph");
@@ -284,15 +281,23 @@ GvdResult BuildGvd(const Udf& udf, const SeedCloud& seeds, const BuildGvdOptions
       }
     for (size_t i = 0; i < n; ++i) std::sort(adj.begin() + static_cast<long>(offset[i]), adj.begin() + static_cast<long>(offset[i + 1]));
   }
-  const size_t kept_edges = offset[n] / 2;
   monitor.Info(Format("kNN graph (k=%d): %zu edges; pruned %zu with midpoint UDF > %.3g, %zu with |cos(edge, "
                       "gradient)| > %.3g; %zu left",
-                      kk, stats.edges_knn, pruned_udf, eps_udf, pruned_grad, options.eps_grad, kept_edges));
+                      kk, stats.edges_knn, pruned_udf, eps_udf, pruned_grad, options.eps_grad, offset[n] / 2));
+  return Graph{std::move(edges), std::move(keep), std::move(offset), std::move(adj)};
+}
 
-  // 4. Multi-source Dijkstra, hand-written (a binary heap over (distance, node) pairs): no installed library
+// Step 4: multi-source Dijkstra over the graph from the seed nodes, Euclidean edge lengths: every node's
+// geodesically nearest seed (label, -1 if unreached) and its distance.
+void GeodesicSweep(const Graph& g, const std::vector<Vec3>& node, const std::vector<int>& node_seed,
+                   std::vector<double>* dist_out, std::vector<int>* label_out, Monitor& monitor) {
+  const size_t n = node.size();
+  // Hand-written (a binary heap over (distance, node) pairs): no installed library
   // runs a multi-source sweep that also records the source. Sequential, hence deterministic.
-  std::vector<double> dist(n, INFINITY);
-  std::vector<int> label(n, -1);
+  std::vector<double>& dist = *dist_out;
+  std::vector<int>& label = *label_out;
+  dist.assign(n, INFINITY);
+  label.assign(n, -1);
   using Item = std::pair<double, int>;
   std::priority_queue<Item, std::vector<Item>, std::greater<Item>> heap;
   for (size_t i = 0; i < n; ++i)
@@ -309,8 +314,8 @@ GvdResult BuildGvd(const Udf& udf, const SeedCloud& seeds, const BuildGvdOptions
       const size_t su = static_cast<size_t>(u);
       if (du > dist[su]) continue;
       task.Advance(1);
-      for (size_t a = offset[su]; a < offset[su + 1]; ++a) {
-        const size_t v = static_cast<size_t>(adj[a]);
+      for (size_t a = g.offset[su]; a < g.offset[su + 1]; ++a) {
+        const size_t v = static_cast<size_t>(g.adj[a]);
         const double dv = du + (node[v] - node[su]).norm();
         if (dv < dist[v]) {
           dist[v] = dv;
@@ -320,11 +325,13 @@ GvdResult BuildGvd(const Udf& udf, const SeedCloud& seeds, const BuildGvdOptions
       }
     }
   }
-  for (size_t i = 0; i < n; ++i) stats.unreached += label[i] < 0 ? 1 : 0;
-  if (stats.unreached > 0)
-    monitor.Warn(Format("%zu of %zu samples are not reached from any seed (label -1)", stats.unreached, n));
+}
 
-  // 5. Dual triangles. Per thread lists, then one sort: the result does not depend on the scheduling.
+// Step 5: the witnessed triples, every (i, j, k) with a node of label i and graph neighbours of labels j
+// and k (all distinct, all >= 0), sorted, each once.
+std::vector<Tri> WitnessedTriples(const Graph& g, const std::vector<int>& label) {
+  const size_t n = label.size();
+  // Per thread lists, then one sort: the result does not depend on the scheduling.
   std::vector<std::vector<Tri>> per_thread(static_cast<size_t>(omp_get_max_threads()));
 #pragma omp parallel
   {
@@ -336,8 +343,8 @@ GvdResult BuildGvd(const Udf& udf, const SeedCloud& seeds, const BuildGvdOptions
       const int i = label[u];
       if (i < 0) continue;
       others.clear();
-      for (size_t a = offset[u]; a < offset[u + 1]; ++a) {
-        const int l = label[static_cast<size_t>(adj[a])];
+      for (size_t a = g.offset[u]; a < g.offset[u + 1]; ++a) {
+        const int l = label[static_cast<size_t>(g.adj[a])];
         if (l >= 0 && l != i) others.push_back(l);
       }
       std::sort(others.begin(), others.end());
@@ -350,10 +357,69 @@ GvdResult BuildGvd(const Udf& udf, const SeedCloud& seeds, const BuildGvdOptions
         }
     }
   }
-  std::vector<Tri>& faces = result.thick.faces;
+  std::vector<Tri> faces;
   for (auto& v : per_thread) faces.insert(faces.end(), v.begin(), v.end());
   std::sort(faces.begin(), faces.end());
   faces.erase(std::unique(faces.begin(), faces.end()), faces.end());
+  return faces;
+}
+
+}  // namespace
+
+GvdResult BuildGvd(const Udf& udf, const SeedCloud& seeds, const BuildGvdOptions& options, bool with_graph,
+                   Monitor& monitor) {
+  options.Check();
+  const size_t num_seeds = seeds.size();
+  if (num_seeds == 0) throw InputError("the seeds file has no seeds");
+  if (num_seeds > static_cast<size_t>(std::numeric_limits<int>::max() / 4))
+    throw InputError("too many seeds for 32-bit mesh indices");
+  const Box box = udf.Domain();
+  const double diag = box.Diagonal();
+  GvdResult result;
+  BuildGvdStats& stats = result.stats;
+
+  // 1. Dense samples, projected onto the zero set.
+  size_t in_space = 0;
+  std::vector<Vec3> samples = DrawSamples(seeds, box, options, &in_space);
+  const size_t total = samples.size();
+  stats.samples_drawn = total;
+  ProjectionOptions proj;
+  proj.tolerance = options.proj_tol_rel * diag;
+  proj.max_iterations = options.proj_max_iters;
+  const ProjectionResult projected = ProjectToZeroSet(udf, samples, proj, monitor);
+  stats.samples_projected = projected.num_converged;
+
+  // 2. Nodes.
+  std::vector<Vec3> node;
+  std::vector<int> node_seed;
+  MakeNodes(seeds, samples, projected, box, stats, &node, &node_seed);
+  const size_t n = node.size();
+  stats.nodes = n;
+  if (stats.seeds_duplicate > 0)
+    monitor.Warn(Format("%zu seeds coincide with an earlier seed (same 2^-21 Morton cell) and are left out",
+                        stats.seeds_duplicate));
+  monitor.Info(Format("%zu dense samples drawn (%zu in the box, %zu around seeds), %zu on the zero set, "
+                      "%zu duplicates dropped; graph of %zu nodes (%zu seeds)",
+                      total, in_space, total - in_space, stats.samples_projected, stats.samples_duplicate, n,
+                      num_seeds - stats.seeds_duplicate));
+  // Gradients at the nodes (on the zero set this is a surface normal of either orientation).
+  std::vector<double> node_d;
+  std::vector<Vec3> node_n;
+  udf.Evaluate(node, node_d, node_n);
+  monitor.Debug("node gradients evaluated");
+
+  // 3-4. Graph and sweep.
+  const Graph graph = PrunedGraph(udf, node, node_d, node_n, options, diag, stats, monitor);
+  std::vector<double> dist;
+  std::vector<int> label;
+  GeodesicSweep(graph, node, node_seed, &dist, &label, monitor);
+  for (size_t i = 0; i < n; ++i) stats.unreached += label[i] < 0 ? 1 : 0;
+  if (stats.unreached > 0)
+    monitor.Warn(Format("%zu of %zu samples are not reached from any seed (label -1)", stats.unreached, n));
+
+  // 5-6. Witnessed triples; with the default dual, the locally Delaunay ones.
+  std::vector<Tri>& faces = result.thick.faces;
+  faces = WitnessedTriples(graph, label);
   if (options.dual == "delaunay") {
     RestrictedDualStats rd;
     std::vector<Vec3> seed_normal;
@@ -380,9 +446,9 @@ GvdResult BuildGvd(const Udf& udf, const SeedCloud& seeds, const BuildGvdOptions
     if (!std::isfinite(d)) d = -1.0;
   ls.dist = std::move(dist);
   if (with_graph) {
-    ls.edges.reserve(kept_edges);
-    for (size_t e = 0; e < edges.size(); ++e)
-      if (keep[e]) ls.edges.push_back({edges[e].first, edges[e].second});
+    ls.edges.reserve(graph.offset[n] / 2);
+    for (size_t e = 0; e < graph.edges.size(); ++e)
+      if (graph.keep[e]) ls.edges.push_back({graph.edges[e].first, graph.edges[e].second});
   }
   return result;
 }
