@@ -430,6 +430,45 @@ TEST(EvaluateFloor, IsTheReferenceAgainstItsOtherSamples) {
   EXPECT_FALSE(Eval(Cube(6), Cube(6)).has_floor);
 }
 
+// ---- feature recall ----
+
+TEST(EvaluateFeatures, FeatureEdgesAreTheCreasesAndBranchingCurves) {
+  EXPECT_EQ(FeatureEdges(Cube(3), 30).size(), 12u * 3);
+  EXPECT_TRUE(FeatureEdges(Sphere(3), 30).empty()) << "an icosphere's dihedrals are a few degrees";
+  EXPECT_TRUE(FeatureEdges(Square(4), 30).empty());
+  EXPECT_EQ(FeatureEdges(Book(3), 30).size(), 1u) << "the spine of three pages is non-manifold";
+  EXPECT_EQ(Corners(FeatureEdges(Cube(3), 30)).size(), 8u);
+  EXPECT_EQ(BoundaryEdges(Square(4)).size(), 16u);
+}
+
+TEST(EvaluateFeatures, TheCubeTracesItsTwelveEdgesAndEightCornersTheSphereDoesNot) {
+  const Metrics self = Eval(Cube(6), Cube(6));
+  EXPECT_NEAR(self.features.feature_length, 12.0, 1e-9);
+  EXPECT_EQ(self.features.recall, 1.0);
+  EXPECT_EQ(self.features.corners, 8u);
+  EXPECT_EQ(self.features.corners_matched, 8u);
+  EXPECT_LT(self.features.feature_mean_x1e3, 1e-6);
+  EXPECT_EQ(self.features.boundary_length, 0.0);
+  const Metrics round = Eval(Sphere(3), Cube(6));
+  EXPECT_LT(round.features.recall, 0.2);
+  EXPECT_EQ(round.features.corners_matched, 0u);
+  EXPECT_TRUE(std::isinf(round.features.feature_max_x1e3)) << "a smooth mesh has no feature edge to be near";
+}
+
+TEST(EvaluateFeatures, ANotchInTheRimGivesItsDepth) {
+  // Square(4) without its corner face (0, 1, 6): the rim 0-1 is replaced by the diagonal 0-6 and the edge
+  // 1-6. The rim sample farthest from the mesh's rim is at x = 0.25 / (1 + 1/sqrt2), 0.1036 from both.
+  TriangleMesh notched = Square(4);
+  notched.faces.erase(notched.faces.begin());
+  const Metrics m = Eval(notched, Square(4));
+  EXPECT_NEAR(m.features.boundary_length, 4.0, 1e-9);
+  const double depth = 0.25 / (1 + 1 / std::sqrt(2.0)) / std::sqrt(2.0);
+  EXPECT_NEAR(m.features.boundary_max_x1e3, depth / std::sqrt(2.0) * 1e3, 0.01 * depth / std::sqrt(2.0) * 1e3);
+  EXPECT_LT(m.features.boundary_recall, 1.0);
+  EXPECT_GT(m.features.boundary_recall, 0.9);
+  EXPECT_EQ(Eval(Square(4), Square(4)).features.boundary_recall, 1.0);
+}
+
 // ---- ECD ----
 
 TEST(EvaluateEcd, SphereReferenceHasNoEdgePointsSoEcdIsZero) {

@@ -96,6 +96,7 @@ void EvaluateOptions::Check() const {
   if (!(weld_tolerance >= 0 && weld_tolerance < 0.1)) throw UsageError("weld tolerance must be in [0, 0.1)");
   if (empty_edge_points < 1) throw UsageError("the ECD stand-in needs at least one point");
   if (edge_samples < 1 || edge_samples > 100000000) throw UsageError("--edge-samples must be in [1, 1e8]");
+  if (!(feature_angle_deg > 0 && feature_angle_deg < 180)) throw UsageError("--feature-angle must be in (0, 180)");
 }
 
 Frame ReferenceFrame(const TriangleMesh& reference) {
@@ -512,12 +513,18 @@ Metrics Evaluate(const TriangleMesh& mesh_in, const TriangleMesh& reference_in, 
     m.nmcd_x1e3 = Chamfer(ref_nm, mesh_nm, monitor).SumOfMeans() * 1e3;
   }
   m.exact = ExactDistances(mesh, ref, mesh_welded, ref_welded, mesh_samples, ref_samples, options, m, monitor);
+  m.features = FeatureRecall(mesh_welded, ref_welded, options.feature_angle_deg, options.edge_samples,
+                             m.frame.ref_diagonal, monitor);
   if (options.floor) {
     m.has_floor = true;
     m.floor = SampledFloor(ref, ref_samples, ref_edge, options, m.frame.ref_diagonal, monitor);
   }
   monitor.Info(Fmt("exact: CD %.6g (x1e3)  HD %.6g (x1e3)  p99 %.6g (x1e3)", m.exact.cd_x1e3, m.exact.hd_x1e3,
                    m.exact.p99_x1e3) + Fmt("  ECD %.6g (x1e2)", m.exact.ecd_x1e2));
+  monitor.Info(Fmt("features: recall %.4g of length %.4g, corners ", m.features.recall, m.features.feature_length) +
+               std::to_string(m.features.corners_matched) + "/" + std::to_string(m.features.corners) +
+               Fmt(", boundary recall %.4g, boundary max %.4g (x1e3)", m.features.boundary_recall,
+                   m.features.boundary_max_x1e3));
   monitor.Info(Fmt("CD %.6g (x1e3)  HD %.6g (x1e3)  ECD %.6g (x1e2)", m.cd_x1e3, m.hd_x1e3, m.ecd_x1e2) +
                Fmt("  TQ %.4g  TD %.0f  NM-CD %.6g (x1e3)", m.mesh.tq, static_cast<double>(m.td), m.nmcd_x1e3));
   return m;
@@ -553,6 +560,17 @@ std::string MetricsJson(const Metrics& m, const EvaluateOptions& options, const 
   num("hd_exact_ref_mesh_x1e3", m.exact.hd_ref_mesh_x1e3);
   num("hd_exact_mesh_ref_x1e3", m.exact.hd_mesh_ref_x1e3);
   num("ecd_exact_x1e2", m.exact.ecd_x1e2);
+  num("feature_recall", m.features.recall);
+  count("corners", static_cast<long long>(m.features.corners));
+  count("corners_matched", static_cast<long long>(m.features.corners_matched));
+  num("feature_mean_x1e3", m.features.feature_mean_x1e3);
+  num("feature_max_x1e3", m.features.feature_max_x1e3);
+  num("feature_length", m.features.feature_length);
+  num("boundary_recall", m.features.boundary_recall);
+  num("boundary_max_x1e3", m.features.boundary_max_x1e3);
+  num("boundary_length", m.features.boundary_length);
+  num("feature_tolerance", m.features.tolerance);
+  num("ref_diagonal", m.frame.ref_diagonal);
   if (m.has_floor) {
     num("cd_floor_x1e3", m.floor.cd_x1e3);
     num("hd_floor_x1e3", m.floor.hd_x1e3);

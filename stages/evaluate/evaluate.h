@@ -10,6 +10,7 @@
 #include "common/mesh_topology.h"
 #include "common/monitor.h"
 #include "common/types.h"
+#include "stages/evaluate/features.h"
 
 namespace voroudf {
 
@@ -23,6 +24,7 @@ struct EvaluateOptions {
   size_t empty_edge_points = 486;  ///< ECD: origin points standing in when the mesh has no edge point (NMC)
   size_t edge_samples = 10000;   ///< exact ECD: samples per mesh along its sharp edges, by length (--edge-samples)
   bool floor = false;            ///< also the sampled metrics of the reference against itself (--floor)
+  double feature_angle_deg = 30.0;  ///< feature recall: an edge whose dihedral departs from flat by more (--feature-angle)
 
   /// Throws UsageError for values that cannot work.
   void Check() const;
@@ -161,6 +163,7 @@ struct Metrics {
   double nmcd_x1e3 = 0;  ///< non-manifold Chamfer (sum of means) x1e3; +infinity if only one side has such edges
   long long td = 0;      ///< |chi(mesh) - chi(ref)|
   ExactMetrics exact;
+  FeatureMetrics features;
   bool has_floor = false;  ///< `floor` computed (EvaluateOptions::floor)
   FloorMetrics floor;
   MeshReport mesh, ref;

@@ -25,6 +25,8 @@ int main(int argc, char** argv) {
   app.add_option("--samples", options.samples, "area-uniform surface samples per mesh (CD, HD, ECD)");
   app.add_option("--nm-samples", options.nm_samples, "samples per mesh along its non-manifold edges (NM-CD)");
   app.add_option("--edge-samples", options.edge_samples, "samples per mesh along its sharp edges (exact ECD)");
+  app.add_option("--feature-angle", options.feature_angle_deg,
+                 "feature recall: edges whose dihedral departs from flat by more than this (degrees)");
   app.add_flag("--floor", options.floor,
                "also the sampled CD/HD/ECD of the reference against itself (keys *_floor_*): their sampling floor");
   // Off by default: wall-clock time would make the output bytes differ from run to run.

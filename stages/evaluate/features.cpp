@@ -1,0 +1,141 @@
+#include "stages/evaluate/features.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <map>
+
+#include "stages/evaluate/evaluate.h"
+
+namespace voroudf {
+namespace {
+
+Vec3 FaceNormal(const TriangleMesh& m, const Tri& t) {
+  const Vec3 c = (m.vertices[static_cast<size_t>(t[1])] - m.vertices[static_cast<size_t>(t[0])])
+                     .cross(m.vertices[static_cast<size_t>(t[2])] - m.vertices[static_cast<size_t>(t[0])]);
+  const double len = c.norm();
+  return len > 0 ? Vec3(c / len) : Vec3::Zero();
+}
+
+// Whether face t runs along the directed edge a -> b.
+bool Runs(const Tri& t, int a, int b) {
+  for (int k = 0; k < 3; ++k)
+    if (t[static_cast<size_t>(k)] == a && t[static_cast<size_t>((k + 1) % 3)] == b) return true;
+  return false;
+}
+
+double MedianEdgeLength(const TriangleMesh& m) {
+  const EdgeFaces ef = BuildEdgeFaces(m.faces);
+  std::vector<double> len;
+  len.reserve(ef.edges.size());
+  for (const Edge& e : ef.edges)
+    len.push_back((m.vertices[static_cast<size_t>(e[1])] - m.vertices[static_cast<size_t>(e[0])]).norm());
+  if (len.empty()) return 0.0;
+  std::nth_element(len.begin(), len.begin() + static_cast<long>(len.size() / 2), len.end());
+  return len[len.size() / 2];
+}
+
+std::vector<Edge> AllEdges(const TriangleMesh& m) { return BuildEdgeFaces(m.faces).edges; }
+
+// Share of the samples of `edges` (by length) within `tol` of `targets`, and their mean and largest distance.
+struct Coverage {
+  double share = 1, mean = 0, max = 0, length = 0;
+};
+Coverage Cover(const TriangleMesh& from, const std::vector<Edge>& edges, const TriangleMesh& to,
+               const std::vector<Edge>& targets, double tol, size_t samples, Monitor& monitor) {
+  Coverage c;
+  const std::vector<Vec3> points = SampleEdges(from, edges, samples, &c.length);
+  if (points.empty()) return c;
+  if (targets.empty()) {
+    c.share = 0;
+    c.mean = c.max = std::numeric_limits<double>::infinity();
+    return c;
+  }
+  const std::vector<double> d = DistancesToSegments(points, to.vertices, targets, monitor);
+  size_t within = 0;
+  double sum = 0;
+  for (double x : d) {
+    within += x <= tol ? 1 : 0;
+    sum += x;
+    c.max = std::max(c.max, x);
+  }
+  c.share = static_cast<double>(within) / static_cast<double>(d.size());
+  c.mean = sum / static_cast<double>(d.size());
+  return c;
+}
+
+}  // namespace
+
+std::vector<Edge> FeatureEdges(const TriangleMesh& mesh, double min_angle_deg) {
+  const EdgeFaces ef = BuildEdgeFaces(mesh.faces);
+  const double max_cos = std::cos(min_angle_deg * M_PI / 180.0);
+  std::vector<Edge> out;
+  for (size_t e = 0; e < ef.edges.size(); ++e) {
+    const auto& fs = ef.faces[e];
+    if (fs.size() >= 3) {
+      out.push_back(ef.edges[e]);
+      continue;
+    }
+    if (fs.size() != 2) continue;
+    const Tri& f0 = mesh.faces[static_cast<size_t>(fs[0])];
+    const Tri& f1 = mesh.faces[static_cast<size_t>(fs[1])];
+    const Vec3 n0 = FaceNormal(mesh, f0);
+    Vec3 n1 = FaceNormal(mesh, f1);
+    if (n0.isZero() || n1.isZero()) continue;
+    const int a = ef.edges[e][0], b = ef.edges[e][1];
+    // Consistently oriented faces run along the edge in opposite directions; otherwise turn one round.
+    if (Runs(f0, a, b) == Runs(f1, a, b)) n1 = -n1;
+    if (n0.dot(n1) < max_cos) out.push_back(ef.edges[e]);
+  }
+  return out;
+}
+
+std::vector<Edge> BoundaryEdges(const TriangleMesh& mesh) {
+  const EdgeFaces ef = BuildEdgeFaces(mesh.faces);
+  std::vector<Edge> out;
+  for (size_t e = 0; e < ef.edges.size(); ++e)
+    if (ef.faces[e].size() == 1) out.push_back(ef.edges[e]);
+  return out;
+}
+
+std::vector<int> Corners(const std::vector<Edge>& edges) {
+  std::map<int, int> degree;
+  for (const Edge& e : edges) ++degree[e[0]], ++degree[e[1]];
+  std::vector<int> out;
+  for (const auto& [v, d] : degree)
+    if (d >= 3) out.push_back(v);
+  return out;
+}
+
+FeatureMetrics FeatureRecall(const TriangleMesh& mesh, const TriangleMesh& ref, double feature_angle_deg,
+                             size_t samples, double diagonal, Monitor& monitor) {
+  FeatureMetrics f;
+  f.tolerance = 0.1 * MedianEdgeLength(mesh);
+  const std::vector<Edge> ref_features = FeatureEdges(ref, feature_angle_deg);
+  const std::vector<Edge> mesh_features = FeatureEdges(mesh, feature_angle_deg);
+  const Coverage on_edges = Cover(ref, ref_features, mesh, AllEdges(mesh), f.tolerance, samples, monitor);
+  f.feature_length = on_edges.length;
+  f.recall = on_edges.share;
+  const Coverage on_features = Cover(ref, ref_features, mesh, mesh_features, f.tolerance, samples, monitor);
+  f.feature_mean_x1e3 = on_features.mean * 1e3;
+  f.feature_max_x1e3 = on_features.max / diagonal * 1e3;
+  const std::vector<int> corners = Corners(ref_features);
+  f.corners = corners.size();
+  if (!corners.empty()) {
+    std::vector<Vec3> at;
+    for (int v : corners) at.push_back(ref.vertices[static_cast<size_t>(v)]);
+    const std::vector<Edge> points = [&] {
+      std::vector<Edge> p;
+      for (size_t v = 0; v < mesh.vertices.size(); ++v) p.push_back({static_cast<int>(v), static_cast<int>(v)});
+      return p;
+    }();
+    for (double d : DistancesToSegments(at, mesh.vertices, points, monitor)) f.corners_matched += d <= f.tolerance ? 1 : 0;
+  }
+  const Coverage rim = Cover(ref, BoundaryEdges(ref), mesh, BoundaryEdges(mesh), f.tolerance, samples, monitor);
+  f.boundary_length = rim.length;
+  f.boundary_recall = rim.share;
+  f.boundary_max_x1e3 = rim.max / diagonal * 1e3;
+  return f;
+}
+
+}  // namespace voroudf
