@@ -548,6 +548,47 @@ TEST(OptimizeSeeds, SphereWithDiscRankTwoSeedsOnTheEquator) {
   ExpectRankTwoOnFeatures("sphere-disc", equator, equator, 20, 2.0);
 }
 
+// Curved features: with --feature-chord-tol, the chain of seeds on sphere-disc's equator (a circle of radius
+// 0.5, about 4.5 spacings at 200 seeds) follows it to within the tolerance: every chord between consecutive
+// equator seeds that is long enough to be split (2.5 × the feature clearance) has its midpoint within
+// the tolerance of the circle; without it such chords cut inside the circle by more. Seeds were added.
+TEST(OptimizeSeeds, FeatureChordsFollowACurvedFeatureWithinTheTolerance) {
+  const auto udf = MakeShape("sphere-disc");
+  const SeedCloud in = Initial(*udf, 200, 5);
+  const double tol = 0.02;
+  struct Chain {
+    size_t seeds = 0;
+    double spacing = 0.0, worst = 0.0;  // worst: the largest 0.5 − |chord midpoint| over splittable chords
+  };
+  auto chain = [&](double chord_tol) {
+    OptimizeSeedsOptions options;
+    options.feature_chord_tol = chord_tol;
+    const SeedCloud out = OptimizeSeeds(*udf, in, options, Monitor::Null());
+    Chain c;
+    c.seeds = out.size();
+    NearestNeighbourCv(out.position, &c.spacing);
+    std::vector<double> angle;
+    for (size_t i = 0; i < out.size(); ++i) {
+      const Vec3& p = out.position[i];
+      if (out.rank[i] < 2) continue;
+      EXPECT_LT(std::hypot(std::hypot(p.x(), p.y()) - 0.5, p.z()), 1e-4) << "rank-2 seed off the equator";
+      angle.push_back(std::atan2(p.y(), p.x()));
+    }
+    std::sort(angle.begin(), angle.end());
+    EXPECT_GE(angle.size(), 8u);
+    const double splittable = 1.1 * 2.5 * options.feature_clearance * c.spacing;
+    for (size_t k = 0; k < angle.size(); ++k) {
+      const double gap = k + 1 < angle.size() ? angle[k + 1] - angle[k] : angle[0] + 2 * M_PI - angle[k];
+      if (2 * 0.5 * std::sin(0.5 * gap) >= splittable) c.worst = std::max(c.worst, 0.5 * (1.0 - std::cos(0.5 * gap)));
+    }
+    return c;
+  };
+  const Chain plain = chain(0.0), refined = chain(tol);
+  EXPECT_GT(plain.worst, 1.5 * tol * plain.spacing) << "the test shape must bend away from its chords";
+  EXPECT_LE(refined.worst, 1.2 * tol * refined.spacing);
+  EXPECT_GT(refined.seeds, plain.seeds);
+}
+
 // The stopping rules fire before the caps: the inner loop at the first round whose projected gradient
 // does not decrease by δ, the outer loop at the first iteration where σ stops growing and the spacing
 // CV improves by less than outer_tol (and not before it).

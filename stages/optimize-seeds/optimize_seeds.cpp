@@ -30,6 +30,7 @@ void OptimizeSeedsOptions::Check() const {
   if (!(sigma_min_spacing >= 0.0 && sigma_min_spacing <= 10.0)) throw UsageError("--sigma-min-spacing must be in [0, 10]");
   if (!(feature_clearance >= 0.0 && feature_clearance <= 1.0)) throw UsageError("--feature-clearance must be in [0, 1]");
   if (feature_steps < 0) throw UsageError("--feature-steps must be at least 0");
+  if (!(feature_chord_tol >= 0.0 && feature_chord_tol <= 1.0)) throw UsageError("--feature-chord-tol must be in [0, 1]");
   if (sigma_max_spacing > 0.0 && sigma_min_spacing > sigma_max_spacing)
     throw UsageError("--sigma-min-spacing must not exceed --sigma-max-spacing");
   if (!(repulsion_cutoff >= 1.0 && repulsion_cutoff <= 10.0)) throw UsageError("--repulsion-cutoff must be in [1, 10]");
@@ -119,6 +120,9 @@ size_t ThinCrowded(State& s, const std::vector<Vec3>& where, const std::vector<d
   }
   return dropped;
 }
+
+// Rounds of RefineFeatureChords: each halves the chords it refines, so their misfit falls by 4 per round.
+constexpr int kFeatureChordRounds = 4;
 
 class Optimizer {
  public:
@@ -235,8 +239,9 @@ class Optimizer {
   // features_only: only seeds whose cells have rank ≥ 2 (sharp edges, corners, rims) move.
   // misfit_at_target (optional): per seed, TangentMisfit at its new position, from the solver's terms (+inf
   // for a seed that did not move).
+  // movers (optional): only the seeds marked there move.
   std::vector<Vec3> L1Step(const State& s, const CellSamples& cells, bool features_only = false,
-                           std::vector<double>* misfit_at_target = nullptr) {
+                           std::vector<double>* misfit_at_target = nullptr, const std::vector<char>* movers = nullptr) {
     const long n = static_cast<long>(s.position.size());
     if (misfit_at_target) misfit_at_target->assign(static_cast<size_t>(n), INFINITY);
     L1TangentOptions solver;
@@ -252,7 +257,7 @@ class Optimizer {
       problem.gamma = options_.gamma;
 #pragma omp for schedule(dynamic, 32)
       for (long i = 0; i < n; ++i) {
-        if (features_only && s.rank[i].rank < 2) continue;
+        if ((features_only && s.rank[i].rank < 2) || (movers && !(*movers)[static_cast<size_t>(i)])) continue;
         const Vec3& x0 = s.position[i];
         // Lengths relative to the domain diagonal (DESIGN.md), so γ means the same for any scale of the
         // shape; the paper's shapes are normalised to about unit size, where its γ = 10 was chosen.
@@ -303,6 +308,117 @@ class Optimizer {
       monitor_.Debug(std::to_string(failed) + " L1 steps hit --l1-max-steps before the gap certificate "
                      "(their best feasible point is used)");
     return moved;
+  }
+
+  // Curved features (not in the paper; docs/optimize-seeds.md, "Curved features"). build-gvd joins
+  // consecutive seeds of a feature curve by a mesh edge, the chord; where the curve bends, the chord's
+  // midpoint lies off it by about h²/8R (h the chord, R the curve's radius), and the mesh cuts across the
+  // feature. Each round finds every chord — a curve seed and the nearest feature seed ahead of it and
+  // behind it along its tangent (and theirs), within 1.5 spacings — and moves a trial seed from the chord's
+  // midpoint onto the curve: projection, then the L1 step in its own cell among all seeds, which is what
+  // puts any seed onto a feature. The trial seed stays when it lands farther than `tolerance` from the
+  // midpoint, strictly between the chord's ends and on a feature (rank ≥ 2). Invariant after the last
+  // round that adds nothing: every chord's midpoint is within `tolerance` of the curve. Sheet seeds nearer
+  // than `clearance` to an added seed are dropped, as the feature-seed thinning does. Returns the count added.
+  size_t RefineFeatureChords(State& s, double tolerance, double clearance, int rounds) {
+    const size_t n0 = s.position.size();
+    size_t added = 0, last_added = 0;
+    for (int round = 0; round < rounds; ++round) {
+      Analyze(s);
+      const size_t n = s.position.size();
+      const double spacing = MeanSpacing(s.position);
+      const std::vector<Vec3> tangent = Tangents(s);
+      std::vector<std::pair<int, int>> chords;
+      {
+        const SeedIndex index(s.position);
+        std::vector<int> found;
+        for (size_t i = 0; i < n; ++i) {
+          if (s.rank[i].rank != 2 || tangent[i].isZero()) continue;
+          index.WithinRadius(s.position[i], 2.5 * spacing, found);
+          int best[2] = {-1, -1};
+          for (int j : found) {  // nearest first
+            const size_t uj = static_cast<size_t>(j);
+            if (uj == i || s.rank[uj].rank < 2) continue;
+            const Vec3 e = s.position[uj] - s.position[i];
+            const double along = e.dot(tangent[i]);
+            if (std::abs(along) < 0.8 * e.norm()) continue;
+            if (!tangent[uj].isZero() && std::abs(e.dot(tangent[uj])) < 0.8 * e.norm()) continue;
+            int& side = best[along > 0.0 ? 0 : 1];
+            if (side < 0) side = j;
+          }
+          for (int j : best)
+            if (j >= 0) chords.emplace_back(std::min<int>(static_cast<int>(i), j), std::max<int>(static_cast<int>(i), j));
+        }
+      }
+      std::sort(chords.begin(), chords.end());
+      chords.erase(std::unique(chords.begin(), chords.end()), chords.end());
+      // After the first round only chords with a seed added in the last round can have changed.
+      if (round > 0)
+        chords.erase(std::remove_if(chords.begin(), chords.end(),
+                                    [&](const auto& c) { return static_cast<size_t>(c.second) < n - last_added; }),
+                     chords.end());
+      last_added = 0;
+      if (chords.empty()) break;
+      std::vector<Vec3> midpoint(chords.size());
+      for (size_t k = 0; k < chords.size(); ++k)
+        midpoint[k] = 0.5 * (s.position[static_cast<size_t>(chords[k].first)] + s.position[static_cast<size_t>(chords[k].second)]);
+      std::vector<Vec3> trial_points = midpoint;
+      const ProjectionResult projected = ProjectToZeroSet(udf_, trial_points, projection_, Monitor::Null());
+      State trial = s;
+      std::vector<size_t> trial_chord;
+      for (size_t k = 0; k < chords.size(); ++k) {
+        if (!projected.converged[k]) continue;
+        trial.position.push_back(trial_points[k]);
+        trial.udf.push_back(projected.distance[k]);
+        trial.normal.push_back(projected.gradient[k]);
+        trial_chord.push_back(k);
+      }
+      trial.rank.resize(trial.position.size());
+      trial.space.resize(trial.position.size());
+      const CellSamples cells = Analyze(trial);
+      std::vector<char> movers(trial.position.size(), 0);
+      std::fill(movers.begin() + static_cast<long>(n), movers.end(), 1);
+      std::vector<Vec3> target = L1Step(trial, cells, false, nullptr, &movers);
+      std::vector<Vec3> landed(target.begin() + static_cast<long>(n), target.end());
+      const ProjectionResult r = ProjectToZeroSet(udf_, landed, projection_, Monitor::Null());
+      const SeedIndex index(s.position);
+      std::vector<int> near;
+      for (size_t t = 0; t < landed.size(); ++t) {
+        const auto [a, b] = chords[trial_chord[t]];
+        const Vec3 &pa = s.position[static_cast<size_t>(a)], &pb = s.position[static_cast<size_t>(b)];
+        const double h = (pb - pa).norm(), u = (landed[t] - pa).dot(pb - pa) / (h * h);
+        if (!r.converged[t] || trial.rank[n + t].rank != 2 || u < 0.25 || u > 0.75) continue;
+        // On the chord's own curve: running along the chord, and off it by a bend (at most a quarter chord), not
+        // a jump to another feature; and not splitting chords shorter than twice the feature-seed clearance.
+        const Vec3 t_new = trial.space[n + t].basis.col(0);
+        const double off = (landed[t] - midpoint[trial_chord[t]]).norm();
+        if (off <= tolerance || off > 0.25 * h || h < 2.5 * clearance || std::abs(t_new.dot(pb - pa)) < 0.8 * h) continue;
+        index.WithinRadius(landed[t], 0.2 * h, near);
+        bool crowded = false;
+        for (int j : near) crowded = crowded || s.rank[static_cast<size_t>(j)].rank >= 2;
+        if (crowded) continue;
+        s.position.push_back(landed[t]);
+        s.udf.push_back(r.distance[t]);
+        s.normal.push_back(r.gradient[t]);
+        ++last_added;
+      }
+      s.rank.resize(s.position.size());
+      s.space.resize(s.position.size());
+      added += last_added;
+      if (last_added == 0) break;
+    }
+    if (added > 0 && clearance > 0.0) {
+      const SeedIndex index(s.position);
+      std::vector<char> drop(s.position.size(), 0);
+      std::vector<int> near;
+      for (size_t i = n0; i < s.position.size(); ++i) {
+        index.WithinRadius(s.position[i], clearance, near);
+        for (int j : near)
+          if (static_cast<size_t>(j) < n0 && s.rank[static_cast<size_t>(j)].rank < 2) drop[static_cast<size_t>(j)] = 1;
+      }
+      EraseSeeds(s, drop);
+    }
+    return added;
   }
 
   // Alg. 1 line 4: σ = the minimum pairwise seed distance — over pairs that repulsion can change, i.e. with
@@ -662,6 +778,18 @@ SeedCloud OptimizeSeeds(const Udf& udf, const SeedCloud& input, const OptimizeSe
   if (crowded > 0)
     monitor.Info(std::to_string(crowded) + Format(" seeds dropped by the feature-seed thinning (nearer than %.2f x the "
                                                   "mean spacing to a kept curve or corner seed)", options.feature_clearance));
+  if (options.feature_chord_tol > 0.0 && options.max_outer_iters > 0) {
+    const double spacing = opt.MeanSpacing(s.position);
+    const size_t before = s.position.size();
+    const size_t added = opt.RefineFeatureChords(s, options.feature_chord_tol * spacing,
+                                                 options.feature_clearance * spacing, kFeatureChordRounds);
+    if (added > 0) {
+      opt.Analyze(s);
+      monitor.Info(std::to_string(added) + " seeds added where a feature curve bends away from the chord between two of "
+                   "its seeds by more than " + Format("%.3g x the mean spacing; ", options.feature_chord_tol) +
+                   std::to_string(before + added - s.position.size()) + " sheet seeds beside them dropped");
+    }
+  }
   OuterIterationReport final_report;
   CountRanks(s, final_report);
   monitor.Info(Format("done in %.2f s; mean |udf| %.3g (rel); spacing CV %.3f -> %.3f; ",

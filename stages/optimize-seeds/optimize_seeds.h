@@ -30,6 +30,10 @@ struct OptimizeSeedsOptions {
   /// L1 steps of the feature seeds (rank ≥ 2) alone after the outer loop, each after fresh cells and ranks
   /// (--feature-steps). Not in the paper's Alg. 1, see docs/optimize-seeds.md.
   int feature_steps = 3;
+  /// Where a feature curve bends away from the chord between two consecutive feature seeds by more than
+  /// this × the mean spacing, a seed is added on the curve between them (--feature-chord-tol; 0: never).
+  /// Not in the paper, see docs/optimize-seeds.md ("Curved features").
+  double feature_chord_tol = 0.0;
   double max_step = 0.5;          ///< trust region: a repulsion round moves a seed at most this many σ (--max-step)
   double repulsion_cutoff = 3.0;  ///< neighbours interact within this many σ (kernel 1.1e-2 at 3σ) (--repulsion-cutoff)
   double l1_tol_rel = 1e-6;       ///< L1 step solved to this position accuracy, relative to the diagonal (--l1-tol-rel)

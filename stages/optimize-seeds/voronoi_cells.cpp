@@ -30,12 +30,14 @@ CellSamples SampleVoronoiCells(const Udf& udf, const std::vector<Vec3>& seeds, c
   std::vector<uint64_t> draws(n, 0);
 
   // Which cells must be redrawn: all, or (given the previous round) those with a moved seed within their
-  // influence radius, before or after the move.
+  // influence radius, before or after the move. Seeds appended since (indices at or above the previous
+  // count) or removed from the end count as moved: appearing or vanishing changes a cell as a move does.
   std::vector<char> redo(n, 1);
-  const bool incremental = previous && previous_seeds && previous_seeds->size() == n && previous->radius.size() == n;
+  const bool incremental = previous && previous_seeds && previous->radius.size() == previous_seeds->size();
   if (incremental) {
-    std::vector<char> moved(n);
-    for (size_t i = 0; i < n; ++i) moved[i] = seeds[i] != (*previous_seeds)[i];
+    const size_t before = previous_seeds->size(), common = std::min(n, before);
+    std::vector<char> moved(std::max(n, before), 1);
+    for (size_t i = 0; i < common; ++i) moved[i] = seeds[i] != (*previous_seeds)[i];
 #pragma omp parallel
     {
       std::vector<int> found;

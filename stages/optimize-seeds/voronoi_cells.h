@@ -44,7 +44,8 @@ struct CellSamples {
 /// radius, neighbours, samples and UDF values) when no seed within its influence radius (2R_i, and the
 /// distance of its k-th nearest seed) moved, before or after the move — such a cell is exactly the same
 /// set, so redrawing it would only change the random draw. Early on, when σ is small and few seeds
-/// move, this saves most of the UDF evaluations.
+/// move, this saves most of the UDF evaluations. Seeds appended at the end, or removed from it, since the
+/// previous call count as moved.
 CellSamples SampleVoronoiCells(const Udf& udf, const std::vector<Vec3>& seeds, const SeedIndex& index,
                                const CellSamplingOptions& options, uint64_t rng_seed, uint64_t round,
                                const CellSamples* previous = nullptr, const std::vector<Vec3>* previous_seeds = nullptr);

@@ -153,7 +153,10 @@ int main(int argc, char** argv) {
       const std::pair<std::string, std::vector<Vec3>> sets[] = {
           {"near surface (±1 % diag)", NearSurface(udf->mesh(), udf->Domain(), n, 1)},
           {"uniform in domain", Uniform(udf->Domain(), n, 2)}};
-      for (const auto& [label, pts] : sets) {
+      for (const auto& set : sets) {
+        // Named, not structured, bindings: clang 14 (the TSan build) cannot capture those in a lambda.
+        const std::string& label = set.first;
+        const std::vector<Vec3>& pts = set.second;
         // Agreement with CGAL (exact closest point in double as well).
         double worst = 0.0;
         udf->Evaluate(pts.data(), n, d.data(), g.data());
