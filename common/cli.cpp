@@ -114,6 +114,8 @@ CLI::Option* StageCli::AddUdf(std::string* spec) {
                 "outputs are in that frame");
   non_semantic_.insert("--udf-timeout");
   non_semantic_.insert("--udf");  // recorded on its own provenance line
+  AddExtraOutput("--udf-stats", &udf_stats_path_,
+                 "also write the UDF queries, batches and seconds inside the UDF to this TSV file");
   return opt;
 }
 
@@ -156,7 +158,8 @@ std::string StageCli::EffectiveOptions(bool semantic_only) const {
 std::unique_ptr<Udf> StageCli::OpenUdf(Monitor& monitor) const {
   std::unique_ptr<Udf> udf = voroudf::OpenUdf(*udf_spec_, udf_options_);
   monitor.Info("UDF: " + udf->Describe());
-  return udf;
+  udf_opened_ = true;
+  return std::make_unique<CountingUdf>(std::move(udf), udf_usage_);
 }
 
 Provenance StageCli::provenance() const {
@@ -206,6 +209,10 @@ int StageCli::Run(int argc, char** argv, const std::function<void()>& check,
     monitor.Info(program_ + " " + EffectiveOptions(false) + "  [" + std::to_string(omp_get_max_threads()) +
                  " threads]");
     body(monitor);
+    if (udf_opened_) {
+      monitor.Info("UDF usage: " + udf_usage_->Summary());
+      if (!udf_stats_path_.empty()) WriteFileAtomically(udf_stats_path_, udf_usage_->Tsv());
+    }
     outputs.Commit();
     SetActiveOutputSet(nullptr);
     return kExitOk;

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "common/counting_udf.h"
 #include "common/monitor.h"
 #include "common/provenance.h"
 #include "common/udf_spec.h"
@@ -35,7 +36,8 @@ class StageCli {
   /// Leaves an already added option (by its long name, e.g. "--trace") out of the provenance's option list:
   /// for options that do not change the results, such as debugging output.
   void MarkNonSemantic(const std::string& flag);
-  /// --udf SPEC (required) plus the source options --udf-box and --udf-timeout.
+  /// --udf SPEC (required) plus the source options --udf-box, --udf-timeout, --udf-normalize and the output
+  /// --udf-stats FILE (the queries made, common/counting_udf.h; also logged at the end).
   CLI::Option* AddUdf(std::string* spec);
   /// --seed for the random number generator.
   CLI::Option* AddSeed(uint64_t* seed);
@@ -44,7 +46,8 @@ class StageCli {
 
   const UdfSourceOptions& udf_options() const { return udf_options_; }
 
-  /// Opens the --udf source with the source options and logs what it is (every stage's first step).
+  /// Opens the --udf source with the source options and logs what it is (every stage's first step). The
+  /// source is wrapped in a CountingUdf: Run logs its usage after the body (and writes --udf-stats).
   /// \pre AddUdf was called and the command line parsed
   std::unique_ptr<Udf> OpenUdf(Monitor& monitor) const;
 
@@ -67,6 +70,9 @@ class StageCli {
   bool quiet_ = false;
   std::string* udf_spec_ = nullptr;
   UdfSourceOptions udf_options_;
+  std::string udf_stats_path_;
+  std::shared_ptr<UdfUsage> udf_usage_ = std::make_shared<UdfUsage>();
+  mutable bool udf_opened_ = false;
   void CheckBeforeWork() const;
 
   std::vector<std::string*> inputs_;

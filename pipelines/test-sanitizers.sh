@@ -32,7 +32,8 @@ case "$KIND" in
     B="$ROOT/build-tsan"
     cmake -S "$ROOT" -B "$B" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++ \
       -DVOROUDF_SANITIZE=thread > /dev/null
-    export TSAN_OPTIONS="halt_on_error=1 second_deadlock_stack=1"
+    # Archer asks for ignore_noninstrumented_modules: the OpenMP runtime itself is not instrumented.
+    export TSAN_OPTIONS="halt_on_error=1 second_deadlock_stack=1 ignore_noninstrumented_modules=1"
     export OMP_TOOL_LIBRARIES=/usr/lib/llvm-14/lib/libarcher.so
     (($#)) || set -- -R "SampleSeeds|OptimizeSeeds|BuildGvd|Evaluate|ExecUdf|Chain"
     ;;

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The whole chain for one shape: sample-seeds -> optimize-seeds -> build-gvd -> thin-mesh [-> evaluate].
-# Every intermediate file is kept in DIR so each stage can be opened in a viewer; DIR/timings.tsv has the
-# wall seconds of each stage.
+# Every intermediate file is kept in DIR so each stage can be opened in a viewer; DIR/timings.tsv has, per
+# stage, its wall seconds and the UDF queries it made, in how many batches, and the seconds inside the UDF
+# ("-" for a swapped-in program, which is not asked for them).
 #
 # Usage: pipelines/voroudf.sh --udf SPEC -o DIR [--count N] [--seed S] [--threads T] [--reference MESH]
 #            [--sample-seeds "ARGS"] [--optimize-seeds "ARGS"] [--build-gvd "ARGS"] [--thin-mesh "ARGS"]
@@ -41,17 +42,25 @@ while (($#)); do
 done
 [ -n "$UDF" ] && [ -n "$OUT" ] || usage
 mkdir -p "$OUT"
-: > "$OUT/timings.tsv"
+printf 'stage\tseconds\tudf_queries\tudf_batches\tudf_seconds\n' > "$OUT/timings.tsv"
 
-# Echoes the command, runs it, appends "stage<TAB>seconds" to timings.tsv.
+# Echoes the command, runs it, appends its row to timings.tsv. Our own programs (the command is
+# $BIN/STAGE) also get --udf-stats, whose numbers go into the row.
 run() {
   local stage=$1; shift
-  echo "+ $*" >&2
-  local t0 t1
+  local stats="$OUT/.udf-stats-$stage.tsv" extra=()
+  [ "$1" = "$BIN/$stage" ] && [ "$stage" != evaluate ] && extra=(--udf-stats "$stats")
+  echo "+ $* ${extra[*]}" >&2
+  local t0 t1 queries=- batches=- inside=-
   t0=$(date +%s.%N)
-  "$@"
+  "$@" "${extra[@]}"
   t1=$(date +%s.%N)
-  awk -v s="$stage" -v a="$t0" -v b="$t1" 'BEGIN { printf "%s\t%.3f\n", s, b - a }' >> "$OUT/timings.tsv"
+  if [ -s "$stats" ]; then
+    read -r queries batches inside < <(sed -n 2p "$stats")
+    rm -f "$stats"
+  fi
+  awk -v s="$stage" -v a="$t0" -v b="$t1" -v q="$queries" -v n="$batches" -v u="$inside" \
+    'BEGIN { printf "%s\t%.3f\t%s\t%s\t%s\n", s, b - a, q, n, u }' >> "$OUT/timings.tsv"
 }
 
 # shellcheck disable=SC2086  # the per-stage ARGS are meant to be split

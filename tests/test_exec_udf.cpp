@@ -315,3 +315,52 @@ TEST(ExecUdfExe, ReferenceServerGivesTheSameSeedsAsTheBuiltInSphere) {
 
 }  // namespace
 }  // namespace voroudf
+
+namespace voroudf {
+namespace {
+
+// A stage's UDF usage (--udf-stats, common/counting_udf.h) is what the source was asked: the points a
+// server received, in at most as many batches as it got requests (a batch may be sent as several).
+TEST_F(FakeServers, UdfStatsCountThePointsTheServerReceived) {
+  const std::string counts = dir_ / "counts.txt";
+  const std::string server = Script("counting.py", FakeServer(
+      "import math\n"
+      "points = requests = 0\n"
+      "while len(head := sys.stdin.buffer.read(4)) == 4:\n"
+      "    n = struct.unpack('<I', head)[0]\n"
+      "    x = struct.unpack('<%df' % (3 * n), sys.stdin.buffer.read(12 * n))\n"
+      "    points += n\n"
+      "    requests += 1\n"
+      "    d, g = [], []\n"
+      "    for i in range(n):\n"
+      "        p = x[3 * i:3 * i + 3]\n"
+      "        r = math.sqrt(sum(c * c for c in p)) or 1.0\n"
+      "        d.append(abs(r - 0.5))\n"
+      "        s = 1.0 if r >= 0.5 else -1.0\n"
+      "        g += [s * c / r for c in p]\n"
+      "    out.write(struct.pack('<I', n) + struct.pack('<%df' % n, *d) + struct.pack('<%df' % (3 * n), *g))\n"
+      "    out.flush()\n"
+      "open(sys.argv[1], 'w').write('%d %d' % (points, requests))\n")) + " " + counts;
+  const std::string stats = dir_ / "stats.tsv", seeds = dir_ / "seeds0.ply";
+  const auto r = RunProgram("sample-seeds",
+                            {"--udf", "exec:" + server, "--count", "200", "-o", seeds, "--udf-stats", stats});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  std::ifstream c(counts), s(stats);
+  uint64_t points = 0, requests = 0, queries = 0, batches = 0;
+  double seconds = -1;
+  std::string header;
+  ASSERT_TRUE(c >> points >> requests);
+  ASSERT_TRUE(std::getline(s, header));
+  EXPECT_EQ(header, "udf_queries\tudf_batches\tudf_seconds");
+  ASSERT_TRUE(s >> queries >> batches >> seconds);
+  EXPECT_GT(points, 200u);
+  EXPECT_EQ(queries, points);
+  EXPECT_GE(batches, 1u);
+  EXPECT_LE(batches, requests);
+  EXPECT_GT(seconds, 0.0);
+  EXPECT_NE(r.err.find("UDF usage: " + std::to_string(queries) + " queries in " + std::to_string(batches) + " batches"),
+            std::string::npos) << r.err;
+}
+
+}  // namespace
+}  // namespace voroudf

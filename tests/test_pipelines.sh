@@ -16,8 +16,13 @@ case "$WHAT" in
     for f in seeds0.ply seeds.ply thick.ply labels.ply mesh.ply nm-edges.ply timings.tsv; do
       [ -s "$TMP/a/$f" ] || fail "voroudf.sh did not write $f"
     done
-    [ "$(cut -f1 "$TMP/a/timings.tsv" | tr '\n' ' ')" = "sample-seeds optimize-seeds build-gvd thin-mesh " ] ||
+    [ "$(cut -f1 "$TMP/a/timings.tsv" | tr '\n' ' ')" = "stage sample-seeds optimize-seeds build-gvd thin-mesh " ] ||
       fail "timings.tsv: $(cat "$TMP/a/timings.tsv")"
+    # Every stage made UDF queries, in at least one batch, and says so (not "-", which is for swapped stages).
+    awk -F'\t' 'NR > 1 && !($3 > 0 && $4 > 0 && $4 <= $3 && $5 >= 0) { exit 1 }' "$TMP/a/timings.tsv" ||
+      fail "timings.tsv lacks the UDF queries: $(cat "$TMP/a/timings.tsv")"
+    grep -q "UDF usage: [0-9]* queries in [0-9]* batches" "$TMP/log" || fail "stages do not log their UDF usage"
+    ! ls "$TMP/a"/.udf-stats-* > /dev/null 2>&1 || fail "the --udf-stats files were left behind"
     grep -q "^+ .*optimize-seeds --udf shape:sphere" "$TMP/log" || fail "commands are not echoed"
     # The same inputs, options and seed give the same bytes through the whole chain.
     bash "$ROOT/pipelines/voroudf.sh" --udf shape:sphere -o "$TMP/b" --count 500 --seed 3 2> /dev/null
@@ -28,6 +33,8 @@ case "$WHAT" in
     VOROUDF_OPTIMIZE_SEEDS="$TMP/keep-seeds" bash "$ROOT/pipelines/voroudf.sh" --udf shape:sphere -o "$TMP/c" \
       --count 300 2> /dev/null
     cmp -s "$TMP/c/seeds0.ply" "$TMP/c/seeds.ply" || fail "the swapped stage was not used"
+    [ "$(awk -F'\t' '$1 == "optimize-seeds" { print $3 }' "$TMP/c/timings.tsv")" = "-" ] ||
+      fail "a swapped stage should have no UDF counts: $(cat "$TMP/c/timings.tsv")"
     [ -s "$TMP/c/mesh.ply" ] || fail "no mesh after swapping a stage"
     # A failing stage stops the chain with its exit code.
     set +e
