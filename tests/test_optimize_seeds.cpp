@@ -406,6 +406,39 @@ TEST(VoronoiCells, SamplesLieInTheirCellAndUnchangedCellsAreKept) {
   check_membership(after);
 }
 
+// Early samples: a cell that clearly sees one plane keeps the first samples of the very draw it would
+// have made whole; a cell on a cube edge or corner (two or three planes) gets all M.
+TEST(VoronoiCells, EarlySamplesArePrefixesAndFeatureCellsStayWhole) {
+  const auto cube = MakeShape("cube");
+  const std::vector<Vec3> seeds = Initial(*cube, 400, 3).position;
+  const SeedIndex index(seeds);
+  CellSamplingOptions whole, early = whole;
+  early.early_samples = 20;
+  early.early_rank_threshold = 0.2;
+  const CellSamples a = SampleVoronoiCells(*cube, seeds, index, whole, 1, 0);
+  const CellSamples b = SampleVoronoiCells(*cube, seeds, index, early, 1, 0);
+  size_t kept_early = 0, feature_cells = 0;
+  for (size_t i = 0; i < seeds.size(); ++i) {
+    const size_t na = a.sample_offset[i + 1] - a.sample_offset[i], nb = b.sample_offset[i + 1] - b.sample_offset[i];
+    for (size_t m = 0; m < nb; ++m) {
+      ASSERT_EQ(b.point[b.sample_offset[i] + m], a.point[a.sample_offset[i] + m]) << "cell " << i;
+      ASSERT_EQ(b.distance[b.sample_offset[i] + m], a.distance[a.sample_offset[i] + m]);
+    }
+    const TangentRank r = ComputeTangentRank(a.gradient.data() + a.sample_offset[i], na, 0.4);
+    if (b.early_kept[i]) {
+      ++kept_early;
+      EXPECT_EQ(nb, 20u);
+      EXPECT_EQ(r.rank, 1) << "cell " << i << " sees a feature with all its samples but stopped early";
+    } else {
+      EXPECT_EQ(nb, na);
+    }
+    feature_cells += r.rank >= 2;
+  }
+  EXPECT_EQ(b.early_cells, kept_early);
+  EXPECT_GT(kept_early, seeds.size() / 2);
+  EXPECT_GT(feature_cells, 20u);
+}
+
 // ---------------------------------------------------------------------------------------------- shapes
 
 double NearestNeighbourCv(const std::vector<Vec3>& p, double* mean_out = nullptr) {

@@ -23,6 +23,7 @@ int main(int argc, char** argv) {
   app.add_option("--trace", trace_dir, "directory for the seeds after every outer iteration (iter-NNN.ply)");
   cli.MarkNonSemantic("--trace");  // debugging output only: not part of the provenance
   app.add_option("-m,--samples-per-cell", o.samples_per_cell, "M: samples per Voronoi cell");
+  app.add_option("--early-samples", o.early_samples, "a cell whose first N samples clearly show one plane keeps those N (0: all get M)");
   app.add_option("--gamma", o.gamma, "proximity weight of the L1 step (lengths relative to the diagonal)");
   app.add_option("--delta", o.delta, "inner loop stops when the projected gradient changes by less than this");
   app.add_option("--max-outer-iters", o.max_outer_iters, "cap on outer iterations (L1 step + repulsion)");

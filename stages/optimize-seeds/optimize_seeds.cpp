@@ -17,6 +17,8 @@ namespace voroudf {
 
 void OptimizeSeedsOptions::Check() const {
   if (samples_per_cell < 3 || samples_per_cell > 100000) throw UsageError("--samples-per-cell must be in [3, 100000]");
+  if (early_samples != 0 && (early_samples < 3 || early_samples > samples_per_cell))
+    throw UsageError("--early-samples must be 0 or in [3, --samples-per-cell]");
   if (!(gamma > 0.0) || !std::isfinite(gamma)) throw UsageError("--gamma must be positive");
   if (!(delta > 0.0 && delta < 1.0)) throw UsageError("--delta must be in (0, 1)");
   if (max_outer_iters < 0) throw UsageError("--max-outer-iters must be at least 0");
@@ -131,6 +133,8 @@ class Optimizer {
     cell_options_.samples_per_cell = options.samples_per_cell;
     cell_options_.radius_knn = options.cell_knn;
     cell_options_.radius_factor = options.cell_radius_factor;
+    cell_options_.early_samples = options.early_samples;
+    cell_options_.early_rank_threshold = 0.5 * options.rank_threshold;
     projection_.tolerance = options.proj_tol_rel * diagonal_;
     projection_.max_iterations = options.proj_max_iters;
   }
@@ -202,10 +206,30 @@ class Optimizer {
     return largest;
   }
 
-  // Cells, samples, rank and null space of every seed at the current positions.
-  CellSamples Analyze(State& s) {
+  // Cells, samples, rank and null space of every seed at the current positions. early: the repulsion
+  // rounds, which only need ranks and null spaces, let cells that clearly see one plane stop at
+  // --early-samples; the L1 steps and the final ranks take every cell whole.
+  CellSamples Analyze(State& s, bool early = false) {
     const SeedIndex index(s.position);
-    CellSamples cells = SampleVoronoiCells(udf_, s.position, index, cell_options_, options_.seed, round_++,
+    CellSamplingOptions cell_options = cell_options_;
+    if (!early) cell_options.early_samples = 0;
+    // Only sheet seeds whose neighbours (last round's cells) are all sheet seeds may stop early: beside a
+    // feature a second sheet can cover a small part of a cell, which the first samples may miss.
+    std::vector<char> allowed;
+    if (early && cell_options.early_samples > 0) {
+      const size_t n = s.position.size();
+      allowed.assign(n, 0);
+      if (cached_cells_.radius.size() == n) {
+        for (size_t i = 0; i < n; ++i) {
+          bool sheet = s.rank[i].rank == 1;
+          for (size_t k = cached_cells_.neighbour_offset[i]; k < cached_cells_.neighbour_offset[i + 1] && sheet; ++k)
+            sheet = s.rank[static_cast<size_t>(cached_cells_.neighbour[k])].rank == 1;
+          allowed[i] = sheet;
+        }
+      }
+      cell_options.early_allowed = &allowed;
+    }
+    CellSamples cells = SampleVoronoiCells(udf_, s.position, index, cell_options, options_.seed, round_++,
                                            cached_positions_.empty() ? nullptr : &cached_cells_, &cached_positions_);
     const long n = static_cast<long>(s.position.size());
 #pragma omp parallel for schedule(static)
@@ -231,7 +255,8 @@ class Optimizer {
     cached_positions_ = s.position;
     last_short_cells_ = cells.short_cells;
     if (cells.draws) last_acceptance_ = static_cast<double>(cells.drawn_samples) / static_cast<double>(cells.draws);
-    monitor_.Debug("cells: " + std::to_string(cells.redrawn) + " of " + std::to_string(n) + " redrawn");
+    monitor_.Debug("cells: " + std::to_string(cells.redrawn) + " of " + std::to_string(n) + " redrawn, " +
+                   std::to_string(cells.early_cells) + " of them with their early samples only");
     return cells;
   }
 
@@ -695,7 +720,7 @@ SeedCloud OptimizeSeeds(const Udf& udf, const SeedCloud& input, const OptimizeSe
       double previous_gradient = -1.0;
       for (int inner = 1; inner <= options.max_inner_iters; ++inner) {
         const auto t0 = Clock::now();
-        opt.Analyze(s);
+        opt.Analyze(s, true);
         if (inner == 1) {
           report.sigma = opt.KernelWidth(s);
           if (!std::isfinite(report.sigma)) break;  // every seed is fixed: nothing to repel

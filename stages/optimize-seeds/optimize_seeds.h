@@ -13,6 +13,10 @@ namespace voroudf {
 struct OptimizeSeedsOptions {
   uint64_t seed = 0;              ///< RNG seed for the cell samples (--seed)
   int samples_per_cell = 100;     ///< M, samples per Voronoi cell (paper: 100) (--samples-per-cell)
+  /// In the repulsion rounds, a sheet seed's cell (neighbours sheet seeds too) whose first this many samples
+  /// show one tangent plane clearly (rank 1 at half the rank threshold) keeps only those; 0: every cell
+  /// gets M (--early-samples). Not in the paper, see docs/optimize-seeds.md ("Early samples").
+  int early_samples = 0;
   double gamma = 10.0;            ///< γ, proximity weight, lengths relative to the domain diagonal (paper: 10) (--gamma)
   double delta = 1e-3;            ///< δ, inner loop stops when the gradient changes by less than this, relatively (paper: 1e-3) (--delta)
   int max_outer_iters = 3;        ///< cap on Alg. 1's outer loop (--max-outer-iters; see docs for why 3)

@@ -2,8 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 
 #include "common/rng.h"
+#include "stages/optimize-seeds/l1_tangent.h"
 
 namespace voroudf {
 
@@ -28,6 +30,7 @@ CellSamples SampleVoronoiCells(const Udf& udf, const std::vector<Vec3>& seeds, c
   std::vector<Vec3> candidates(n * m_max);
   std::vector<size_t> accepted(n, 0);
   std::vector<uint64_t> draws(n, 0);
+  std::vector<char> short_draw(n, 0);  // the rejection budget ran out before M samples
 
   // Which cells must be redrawn: all, or (given the previous round) those with a moved seed within their
   // influence radius, before or after the move. Seeds appended since (indices at or above the previous
@@ -45,7 +48,7 @@ CellSamples SampleVoronoiCells(const Udf& udf, const std::vector<Vec3>& seeds, c
       for (long li = 0; li < static_cast<long>(n); ++li) {
         const size_t i = static_cast<size_t>(li);
         if (moved[i]) continue;
-        bool dirty = false;
+        bool dirty = options.early_samples == 0 && !previous->early_kept.empty() && previous->early_kept[i];
         for (size_t k = previous->neighbour_offset[i]; k < previous->neighbour_offset[i + 1] && !dirty; ++k)
           dirty = moved[static_cast<size_t>(previous->neighbour[k])];
         if (!dirty) {
@@ -106,10 +109,56 @@ CellSamples SampleVoronoiCells(const Udf& udf, const std::vector<Vec3>& seeds, c
       }
       accepted[i] = count;
       draws[i] = drawn;
+      short_draw[i] = count < m_max;
     }
   }
 
-  // Assemble; only the redrawn cells' samples go to the UDF.
+  // The UDF at the redrawn cells' candidates, in up to two batches: first the first `early_samples` of
+  // each cell; a cell whose first samples already show one tangent plane clearly (rank 1 at the stricter
+  // threshold early_rank_threshold) keeps just those, the others get the rest in the second batch.
+  cells.early_kept.assign(n, 0);
+  for (size_t i = 0; i < n; ++i)
+    if (!redo[i] && !previous->early_kept.empty()) cells.early_kept[i] = previous->early_kept[i];
+  std::vector<double> cand_d(n * m_max, 0.0);
+  std::vector<Vec3> cand_g(n * m_max, Vec3::Zero());
+  const size_t early = options.early_samples > 0 ? std::min(m_max, static_cast<size_t>(options.early_samples)) : m_max;
+  auto evaluate = [&](size_t from, const std::function<bool(size_t)>& wanted) {
+    std::vector<size_t> at;
+    for (size_t i = 0; i < n; ++i)
+      if (redo[i] && wanted(i))
+        for (size_t k = from; k < std::min(accepted[i], from == 0 ? early : m_max); ++k) at.push_back(i * m_max + k);
+    std::vector<Vec3> points(at.size());
+    for (size_t k = 0; k < at.size(); ++k) points[k] = candidates[at[k]];
+    std::vector<double> d;
+    std::vector<Vec3> g;
+    udf.Evaluate(points, d, g);
+    for (size_t k = 0; k < at.size(); ++k) {
+      cand_d[at[k]] = d[k];
+      cand_g[at[k]] = g[k];
+    }
+  };
+  evaluate(0, [](size_t) { return true; });
+  if (early < m_max) {
+    std::vector<char> more(n, 0);
+    for (size_t i = 0; i < n; ++i) {
+      if (!redo[i] || accepted[i] <= early) continue;
+      if (options.early_allowed && !(*options.early_allowed)[i]) {
+        more[i] = 1;
+        continue;
+      }
+      const TangentRank r = ComputeTangentRank(cand_g.data() + i * m_max, early, options.early_rank_threshold);
+      if (r.rank == 1) {
+        accepted[i] = early;
+        cells.early_kept[i] = 1;
+        ++cells.early_cells;
+      } else {
+        more[i] = 1;
+      }
+    }
+    evaluate(early, [&](size_t i) { return more[i] != 0; });
+  }
+
+  // Assemble.
   cells.neighbour_offset.assign(n + 1, 0);
   cells.sample_offset.assign(n + 1, 0);
   for (size_t i = 0; i < n; ++i) {
@@ -121,20 +170,20 @@ CellSamples SampleVoronoiCells(const Udf& udf, const std::vector<Vec3>& seeds, c
       cells.drawn_samples += accepted[i];
       ++cells.redrawn;
     }
-    if (count < m_max) ++cells.short_cells;
+    if (redo[i] && short_draw[i]) ++cells.short_cells;
   }
   cells.neighbour.reserve(cells.neighbour_offset[n]);
   cells.point.resize(cells.sample_offset[n]);
   cells.distance.resize(cells.sample_offset[n]);
   cells.gradient.resize(cells.sample_offset[n]);
-  std::vector<Vec3> fresh;
-  std::vector<size_t> fresh_at;
   for (size_t i = 0; i < n; ++i) {
     cells.neighbour.insert(cells.neighbour.end(), neighbours[i].begin(), neighbours[i].end());
     const long to = static_cast<long>(cells.sample_offset[i]);
     if (redo[i]) {
-      std::copy_n(candidates.begin() + static_cast<long>(i * m_max), accepted[i], cells.point.begin() + to);
-      for (size_t k = 0; k < accepted[i]; ++k) fresh_at.push_back(cells.sample_offset[i] + k);
+      const long from = static_cast<long>(i * m_max), count = static_cast<long>(accepted[i]);
+      std::copy_n(candidates.begin() + from, count, cells.point.begin() + to);
+      std::copy_n(cand_d.begin() + from, count, cells.distance.begin() + to);
+      std::copy_n(cand_g.begin() + from, count, cells.gradient.begin() + to);
     } else {
       const long from = static_cast<long>(previous->sample_offset[i]);
       const long count = static_cast<long>(previous->sample_offset[i + 1]) - from;
@@ -142,15 +191,6 @@ CellSamples SampleVoronoiCells(const Udf& udf, const std::vector<Vec3>& seeds, c
       std::copy_n(previous->distance.begin() + from, count, cells.distance.begin() + to);
       std::copy_n(previous->gradient.begin() + from, count, cells.gradient.begin() + to);
     }
-  }
-  fresh.resize(fresh_at.size());
-  for (size_t k = 0; k < fresh_at.size(); ++k) fresh[k] = cells.point[fresh_at[k]];
-  std::vector<double> d;
-  std::vector<Vec3> g;
-  udf.Evaluate(fresh, d, g);
-  for (size_t k = 0; k < fresh_at.size(); ++k) {
-    cells.distance[fresh_at[k]] = d[k];
-    cells.gradient[fresh_at[k]] = g[k];
   }
   return cells;
 }

@@ -16,6 +16,13 @@ struct CellSamplingOptions {
   int radius_knn = 6;            ///< k: the cell is bounded by a ball of radius factor × (distance to the k-th nearest seed)
   double radius_factor = 0.5;    ///< as OptimizeSeedsOptions::cell_radius_factor (the stage default)
   int max_draws_per_sample = 100; ///< rejection budget: at most M × this draws (in the ball's bounding cube) per cell
+  /// Two-stage sampling (0: off): a cell whose first `early_samples` samples already have rank 1 at
+  /// `early_rank_threshold` (one tangent plane, clearly: s₂ ≤ that × s₁) keeps only those; the others get
+  /// all M. The samples are a prefix of the same random draw, so a cell that needs M gets the same M.
+  int early_samples = 0;
+  double early_rank_threshold = 0.2;
+  /// Optional, per seed: only cells marked here may stop at their early samples (null: every cell).
+  const std::vector<char>* early_allowed = nullptr;
 };
 
 /// Per seed i: the bounding radius R_i, the seeds within 2 R_i (the only ones whose bisector planes can cut
@@ -31,8 +38,10 @@ struct CellSamples {
   std::vector<Vec3> gradient;
   uint64_t draws = 0;                    ///< candidate points drawn in the bounding cubes in this call
   uint64_t drawn_samples = 0;            ///< of which accepted (acceptance = drawn_samples / draws)
-  size_t short_cells = 0;                ///< cells that got fewer than M samples within the budget
+  size_t short_cells = 0;                ///< redrawn cells that got fewer than M samples within the budget
   size_t redrawn = 0;                    ///< cells sampled in this call (the others were kept)
+  size_t early_cells = 0;                ///< of which kept their early samples only (early_samples)
+  std::vector<char> early_kept;          ///< per cell: 1 if it has its early samples only
 };
 
 /// Draws up to M points uniformly in Ω_i ∩ B(x_i, R_i) for every seed by rejection from the ball's bounding cube (exact
@@ -45,7 +54,8 @@ struct CellSamples {
 /// distance of its k-th nearest seed) moved, before or after the move — such a cell is exactly the same
 /// set, so redrawing it would only change the random draw. Early on, when σ is small and few seeds
 /// move, this saves most of the UDF evaluations. Seeds appended at the end, or removed from it, since the
-/// previous call count as moved.
+/// previous call count as moved. A cell that kept only its early samples is redrawn when this call wants
+/// every cell whole (early_samples = 0).
 CellSamples SampleVoronoiCells(const Udf& udf, const std::vector<Vec3>& seeds, const SeedIndex& index,
                                const CellSamplingOptions& options, uint64_t rng_seed, uint64_t round,
                                const CellSamples* previous = nullptr, const std::vector<Vec3>* previous_seeds = nullptr);
