@@ -104,11 +104,11 @@ CLI::Option* StageCli::AddUdf(std::string* spec) {
   CLI::Option* opt = app_.add_option(
       "--udf", *spec,
       "UDF source: shape:NAME (sphere cube disc hemisphere crossing-planes sphere-disc three-discs torus), "
-      "a mesh .obj/.off/.ply/.stl, a grid .npy, or exec:COMMAND");
+      "a mesh .obj/.off/.ply/.stl, a grid .npy, exec:COMMAND, or unix:SOCKET (a running server)");
   opt->required();
   app_.add_option("--udf-box", udf_options_.grid_box, "domain box of a .npy grid: xmin,ymin,zmin,xmax,ymax,zmax");
   app_.add_option("--udf-timeout", udf_options_.exec_timeout_s,
-                  "seconds to wait for an exec: source's answer (in (0, 1e6])");
+                  "seconds to wait for an exec: or unix: source's answer (in (0, 1e6])");
   app_.add_flag("--udf-normalize", udf_options_.normalize,
                 "centre the source's box (a mesh's bbox) on the origin and scale its largest extent to 1; "
                 "outputs are in that frame");

@@ -8,6 +8,8 @@
 #include <signal.h>
 #include <spawn.h>
 #include <sys/prctl.h>
+#include <sys/socket.h>
+#include <sys/un.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -61,13 +63,14 @@ ssize_t WriteNoSigpipe(int fd, const char* data, size_t n) {
 
 }  // namespace
 
-ExecUdf::ExecUdf(const std::string& command, const ExecUdfOptions& options) : command_(command), options_(options) {
-  if (command_.empty()) throw InputError("exec:", "no command after 'exec:'");
+ExecUdf::ExecUdf(const std::string& command, const ExecUdfOptions& options)
+    : label_("exec:" + command), options_(options) {
+  if (command.empty()) throw InputError("exec:", "no command after 'exec:'");
   int in_pipe[2], out_pipe[2];  // in_pipe: we write, child reads (its stdin); out_pipe: child writes
-  if (pipe2(in_pipe, O_CLOEXEC) != 0) throw InputError("exec:" + command_, std::string("pipe: ") + std::strerror(errno));
+  if (pipe2(in_pipe, O_CLOEXEC) != 0) throw InputError(label_, std::string("pipe: ") + std::strerror(errno));
   if (pipe2(out_pipe, O_CLOEXEC) != 0) {
     close(in_pipe[0]), close(in_pipe[1]);
-    throw InputError("exec:" + command_, std::string("pipe: ") + std::strerror(errno));
+    throw InputError(label_, std::string("pipe: ") + std::strerror(errno));
   }
   // Orphans of the server (children it forked, then died) come back to us rather than to init, so that
   // ending its group can reap them: an init that never reaps (as in some containers) would otherwise
@@ -88,7 +91,7 @@ ExecUdf::ExecUdf(const std::string& command, const ExecUdfOptions& options) : co
   // Own process group, so that a shell pipeline or a server's children can be killed as one.
   posix_spawnattr_setpgroup(&attr, 0);
   posix_spawnattr_setflags(&attr, POSIX_SPAWN_SETPGROUP | POSIX_SPAWN_SETSIGMASK | POSIX_SPAWN_SETSIGDEF);
-  const char* argv[] = {"sh", "-c", command_.c_str(), nullptr};
+  const char* argv[] = {"sh", "-c", command.c_str(), nullptr};
   const int rc = posix_spawn(&pid_, "/bin/sh", &actions, &attr, const_cast<char* const*>(argv), environ);
   posix_spawn_file_actions_destroy(&actions);
   posix_spawnattr_destroy(&attr);
@@ -99,7 +102,7 @@ ExecUdf::ExecUdf(const std::string& command, const ExecUdfOptions& options) : co
   if (rc != 0) {
     pid_ = -1;
     close(to_child_), close(from_child_);
-    throw InputError("exec:" + command_, std::string("cannot run /bin/sh: ") + std::strerror(rc));
+    throw InputError(label_, std::string("cannot run /bin/sh: ") + std::strerror(rc));
   }
   pgid_ = pid_;
   try {
@@ -107,6 +110,35 @@ ExecUdf::ExecUdf(const std::string& command, const ExecUdfOptions& options) : co
   } catch (const Error&) {
     Fail("too many exec: sources at once");
   }
+  Handshake();
+}
+
+ExecUdf::ExecUdf(const UnixSocket& socket, const ExecUdfOptions& options)
+    : label_("unix:" + socket.path), options_(options), over_socket_(true) {
+  if (socket.path.empty()) throw InputError("unix:", "no socket path after 'unix:'");
+  sockaddr_un address{};
+  address.sun_family = AF_UNIX;
+  if (socket.path.size() >= sizeof address.sun_path)
+    throw InputError(label_, "socket path longer than " + std::to_string(sizeof address.sun_path - 1) + " bytes");
+  std::memcpy(address.sun_path, socket.path.data(), socket.path.size());
+  const int fd = ::socket(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0);
+  if (fd < 0) throw InputError(label_, std::string("socket: ") + std::strerror(errno));
+  if (connect(fd, reinterpret_cast<const sockaddr*>(&address), sizeof address) != 0) {
+    const int saved = errno;
+    close(fd);
+    throw InputError(label_, std::string("cannot connect: ") + std::strerror(saved) +
+                                 (saved == ENOENT || saved == ECONNREFUSED ? " (is the server running?)" : ""));
+  }
+  to_child_ = fd;
+  from_child_ = fcntl(fd, F_DUPFD_CLOEXEC, 0);
+  if (from_child_ < 0) {
+    close(to_child_), to_child_ = -1;
+    throw InputError(label_, std::string("dup: ") + std::strerror(errno));
+  }
+  Handshake();
+}
+
+void ExecUdf::Handshake() {
   fcntl(to_child_, F_SETFL, fcntl(to_child_, F_GETFL) | O_NONBLOCK);
   fcntl(from_child_, F_SETFL, fcntl(from_child_, F_GETFL) | O_NONBLOCK);
 
@@ -126,7 +158,10 @@ ExecUdf::ExecUdf(const std::string& command, const ExecUdfOptions& options) : co
 }
 
 ExecUdf::~ExecUdf() {
-  if (to_child_ >= 0) close(to_child_);  // EOF on the server's stdin: the protocol's "goodbye"
+  // EOF on the server's input: the protocol's "goodbye" (a socket is shut down for writing first: its
+  // other descriptor would keep it open).
+  if (to_child_ >= 0 && over_socket_) shutdown(to_child_, SHUT_WR);
+  if (to_child_ >= 0) close(to_child_);
   to_child_ = -1;
   Reap(2.0);
   if (from_child_ >= 0) close(from_child_);
@@ -166,7 +201,7 @@ void ExecUdf::Fail(const std::string& problem) const {
   if (Reap(0.2) && exit_status_ != -1) message += " (the process " + DescribeStatus(exit_status_) + ")";
   if (to_child_ >= 0) close(to_child_), to_child_ = -1;
   if (from_child_ >= 0) close(from_child_), from_child_ = -1;
-  failure_ = "exec:" + command_ + ": " + message;
+  failure_ = label_ + ": " + message;
   throw InputError(failure_);
 }
 
@@ -197,7 +232,8 @@ void ExecUdf::Exchange(const std::string& out, char* in, size_t in_len, const st
       if (n > 0) {
         got += static_cast<size_t>(n);
       } else if (n == 0) {
-        Fail("the process ended (closed its stdout) while we waited for " + what + " (received " + std::to_string(got) +
+        Fail(std::string(over_socket_ ? "the server closed the connection" : "the process ended (closed its stdout)") +
+             " while we waited for " + what + " (received " + std::to_string(got) +
              " of " + std::to_string(in_len) + " bytes)");
       } else if (errno != EAGAIN && errno != EINTR) {
         Fail(std::string("read: ") + std::strerror(errno));
@@ -208,7 +244,8 @@ void ExecUdf::Exchange(const std::string& out, char* in, size_t in_len, const st
       if (n > 0) {
         written += static_cast<size_t>(n);
       } else if (n < 0 && errno == EPIPE) {
-        Fail("the process ended (closed its stdin) before reading the request for " + what);
+        Fail(std::string(over_socket_ ? "the server closed the connection" : "the process ended (closed its stdin)") +
+             " before reading the request for " + what);
       } else if (n < 0 && errno != EAGAIN && errno != EINTR) {
         Fail(std::string("write: ") + std::strerror(errno));
       }
@@ -255,7 +292,7 @@ void ExecUdf::Evaluate(const Vec3* points, size_t count, double* distance, Vec3*
 }
 
 std::string ExecUdf::Describe() const {
-  return "exec:" + command_ + " (server '" + server_name_ + "', protocol " + std::to_string(kVersion) + "; domain " +
+  return label_ + " (server '" + server_name_ + "', protocol " + std::to_string(kVersion) + "; domain " +
          FormatBox(domain_) + " from the handshake)";
 }
 

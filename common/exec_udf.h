@@ -33,14 +33,24 @@ struct ExecUdfOptions {
 /// with exit code 3 (the same outcome as the top-level handler).
 ///
 /// Precision: the protocol carries float32, so distances and positions are good to ~1e-7 relative.
+///
+/// The same protocol over a Unix-domain socket (`--udf unix:PATH`, the UnixSocket constructor): the stage
+/// connects to a server that is already running and may serve many stages; there is no process to start
+/// or end, the rest (handshake, timeouts, errors, goodbye by EOF) is the same.
 class ExecUdf : public Udf {
  public:
+  struct UnixSocket {
+    std::string path;
+  };
   static constexpr uint32_t kVersion = 1;             ///< protocol::kVersion
   static constexpr uint32_t kMaxRequest = 1u << 20;   ///< protocol::kMaxRequest
 
   /// \param command what follows "exec:" in the SPEC, run by /bin/sh -c
   /// Throws InputError if the process cannot start or its handshake is missing, late or malformed.
   ExecUdf(const std::string& command, const ExecUdfOptions& options);
+  /// Connects to the server listening at `socket.path`. Throws InputError if it cannot connect (no such
+  /// socket, nobody listening) or the handshake is missing, late or malformed.
+  ExecUdf(const UnixSocket& socket, const ExecUdfOptions& options);
   ~ExecUdf() override;
   ExecUdf(const ExecUdf&) = delete;
   ExecUdf& operator=(const ExecUdf&) = delete;
@@ -54,6 +64,7 @@ class ExecUdf : public Udf {
   const std::string& server_name() const { return server_name_; }
 
  private:
+  void Handshake();  // from the constructors
   // All below run with mutex_ held (or from the constructor).
   void Query(const Vec3* points, size_t count, double* distance, Vec3* gradient) const;
   /// Writes `out` (may be empty) and reads exactly `in_len` bytes into `in`, both before the deadline.
@@ -61,8 +72,9 @@ class ExecUdf : public Udf {
   [[noreturn]] void Fail(const std::string& problem) const;
   bool Reap(double wait_s) const;
 
-  std::string command_;
+  std::string label_;  // the SPEC: "exec:COMMAND" or "unix:PATH"
   ExecUdfOptions options_;
+  bool over_socket_ = false;
   Box domain_;
   std::string server_name_;
   mutable std::mutex mutex_;

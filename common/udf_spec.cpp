@@ -77,11 +77,12 @@ std::unique_ptr<Udf> NormalizeUdf(std::unique_ptr<Udf> inner, const Box& frame) 
 UdfSourceKind ClassifyUdfSpec(const std::string& spec) {
   if (StartsWith(spec, "shape:")) return UdfSourceKind::kShape;
   if (StartsWith(spec, "exec:")) return UdfSourceKind::kExec;
+  if (StartsWith(spec, "unix:")) return UdfSourceKind::kUnix;
   const std::string ext = LowerExtension(spec);
   if (ext == "obj" || ext == "off" || ext == "ply" || ext == "stl") return UdfSourceKind::kMesh;
   if (ext == "npy") return UdfSourceKind::kGrid;
   throw InputError("--udf '" + spec +
-                   "': expected shape:NAME, a mesh (.obj .off .ply .stl), a grid (.npy) or exec:COMMAND");
+                   "': expected shape:NAME, a mesh (.obj .off .ply .stl), a grid (.npy), exec:COMMAND or unix:SOCKET");
 }
 
 std::unique_ptr<Udf> OpenUdf(const std::string& spec, const UdfSourceOptions& options) {
@@ -106,6 +107,14 @@ std::unique_ptr<Udf> OpenUdf(const std::string& spec, const UdfSourceOptions& op
       if (!options.normalize) return exec;
       const Box frame = exec->Domain();
       return NormalizeUdf(std::move(exec), frame);
+    }
+    case UdfSourceKind::kUnix: {
+      ExecUdfOptions exec_options;
+      exec_options.timeout_s = options.exec_timeout_s;
+      std::unique_ptr<Udf> socket = std::make_unique<ExecUdf>(ExecUdf::UnixSocket{spec.substr(5)}, exec_options);
+      if (!options.normalize) return socket;
+      const Box frame = socket->Domain();
+      return NormalizeUdf(std::move(socket), frame);
     }
   }
   throw InputError(spec, "unknown kind of UDF source");

@@ -8,7 +8,7 @@
 namespace voroudf {
 
 /// What kind of source a SPEC names (by prefix or file extension).
-enum class UdfSourceKind { kShape, kMesh, kGrid, kExec };
+enum class UdfSourceKind { kShape, kMesh, kGrid, kExec, kUnix };
 
 /// Options that apply to some sources (set from the common CLI flags).
 struct UdfSourceOptions {

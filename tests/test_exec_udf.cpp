@@ -364,3 +364,129 @@ TEST_F(FakeServers, UdfStatsCountThePointsTheServerReceived) {
 
 }  // namespace
 }  // namespace voroudf
+
+namespace voroudf {
+namespace {
+
+// unix: sources: the same protocol over a Unix-domain socket to a server that is already running.
+class UnixServers : public ::testing::Test {
+ protected:
+  // Starts `/usr/bin/python3 SCRIPT SOCKET` and waits for the socket to appear.
+  void Start(const std::string& script_body) {
+    test::WriteBytes(dir_ / "server.py", script_body);
+    socket_ = dir_ / "udf.sock";
+    pid_ = fork();
+    ASSERT_GE(pid_, 0);
+    if (pid_ == 0) {
+      execl("/usr/bin/python3", "python3", (dir_ / "server.py").c_str(), socket_.c_str(), static_cast<char*>(nullptr));
+      _exit(127);
+    }
+    for (int i = 0; i < 500 && !test::Exists(socket_ + ".ready"); ++i)
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    ASSERT_TRUE(test::Exists(socket_ + ".ready")) << "the test server did not start";
+  }
+  void TearDown() override {
+    if (pid_ > 0) kill(pid_, SIGKILL), waitpid(pid_, nullptr, 0);
+  }
+  // A one-connection server in Python: binds the socket, accepts once, then the handshake and `body`
+  // with `inp` and `out` on the connection (as FakeServer's stdin and stdout).
+  static std::string OneShot(const std::string& body, bool hello = true) {
+    return "import socket, struct, sys, time\n"
+           "s = socket.socket(socket.AF_UNIX)\n"
+           "s.bind(sys.argv[1])\n"
+           "s.listen(4)\n"
+           "open(sys.argv[1] + '.ready', 'w').close()\n"
+           "conn, _ = s.accept()\n"
+           "inp, out = conn.makefile('rb'), conn.makefile('wb')\n" +
+           std::string(hello ? "out.write(b'VUDF' + struct.pack('<I6fI', 1, -1, -1, -1, 1, 1, 1, 4) + b'fake')\n"
+                               "out.flush()\n"
+                             : "") +
+           body;
+  }
+  void ExpectInputError(const std::string& expect, double timeout_s = 1.0) {
+    const auto start = Clock::now();
+    try {
+      ExecUdfOptions o;
+      o.timeout_s = timeout_s;
+      ExecUdf udf(ExecUdf::UnixSocket{socket_}, o);
+      std::vector<Vec3> pts(10, Vec3(0.1, 0.2, 0.3));
+      std::vector<double> d;
+      std::vector<Vec3> g;
+      udf.Evaluate(pts, d, g);
+      ADD_FAILURE() << "no error";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(expect), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("unix:" + socket_), std::string::npos) << e.what();
+    }
+    EXPECT_LT(Seconds(start), timeout_s + 3.0);
+  }
+  TempDir dir_;
+  std::string socket_;
+  pid_t pid_ = -1;
+};
+
+// One server process serves two stages in turn, and each gets what an exec: server gives.
+TEST_F(UnixServers, OneServerServesSeveralStagesLikeAnExecServer) {
+  // The reference server, marked ready once it takes a connection (the probe's is a client that leaves).
+  Start("import runpy, socket, sys, threading, time\n"
+        "path = sys.argv[1]\n"
+        "def ready():\n"
+        "    while True:\n"
+        "        try:\n"
+        "            c = socket.socket(socket.AF_UNIX)\n"
+        "            c.connect(path)\n"
+        "            c.close()\n"
+        "            break\n"
+        "        except OSError:\n"
+        "            time.sleep(0.01)\n"
+        "    open(path + '.ready', 'w').close()\n"
+        "threading.Thread(target=ready, daemon=True).start()\n"
+        "sys.argv = ['udf_server_sphere.py', '--unix', path]\n"
+        "runpy.run_path('" VOROUDF_SOURCE_DIR "/pipelines/udf_server_sphere.py', run_name='__main__')\n");
+  const std::string unix_seeds = dir_ / "u.ply", exec_seeds = dir_ / "e.ply", unix_opt = dir_ / "uo.ply";
+  auto r = RunProgram("sample-seeds", {"--udf", "unix:" + socket_, "--count", "300", "-o", unix_seeds});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  r = RunProgram("optimize-seeds", {"--udf", "unix:" + socket_, "-i", unix_seeds, "-o", unix_opt, "--max-outer-iters", "1"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  r = RunProgram("sample-seeds", {"--udf", "exec:" + kServer, "--count", "300", "-o", exec_seeds});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const SeedCloud a = ReadSeeds(unix_seeds), b = ReadSeeds(exec_seeds);
+  ASSERT_EQ(a.size(), b.size());
+  for (size_t i = 0; i < a.size(); ++i) EXPECT_EQ(a.position[i], b.position[i]);
+  EXPECT_GT(ReadSeeds(unix_opt).size(), 200u);
+}
+
+TEST_F(UnixServers, EveryMisbehaviourIsAnInputErrorWithinTheTimeout) {
+  socket_ = dir_ / "nobody.sock";
+  ExpectInputError("cannot connect");
+  const std::string out = dir_ / "s.ply";
+  const auto r = RunProgram("sample-seeds", {"--udf", "unix:" + socket_, "--count", "100", "-o", out});
+  EXPECT_EQ(r.exit_code, 3) << r.err;
+  EXPECT_NE(r.err.find("is the server running?"), std::string::npos) << r.err;
+  EXPECT_FALSE(test::Exists(out));
+  Start(OneShot("inp.close()\nout.close()\nconn.close()\ntime.sleep(60)\n", false));
+  ExpectInputError("closed the connection");
+}
+
+TEST_F(UnixServers, AServerThatNeverAnswersTimesOut) {
+  Start(OneShot("time.sleep(60)\n", false));
+  ExpectInputError("--udf-timeout");
+}
+
+TEST_F(UnixServers, GarbageAndAWrongCountAreInputErrors) {
+  Start(OneShot("inp.read(4)\nout.write(struct.pack('<I', 3) + b'x' * 100)\nout.flush()\ntime.sleep(60)\n"));
+  ExpectInputError("answered 3 values to a request of 10");
+}
+
+TEST_F(UnixServers, ABadHandshakeIsAnInputError) {
+  Start(OneShot("out.write(b'HTTP/1.1 200 OK' + b' ' * 40)\nout.flush()\ntime.sleep(60)\n", false));
+  ExpectInputError("VUDF");
+}
+
+TEST_F(UnixServers, AServerThatDiesMidRequestIsAnInputError) {
+  Start(OneShot("inp.read(4)\nsys.exit(0)\n"));
+  ExpectInputError("closed the connection");
+}
+
+}  // namespace
+}  // namespace voroudf
