@@ -12,7 +12,8 @@ PACKAGES=(
   libpcl-dev                         # neighbour search (optimize-seeds)
   libflann-dev                       # kNN graphs (build-gvd)
   libopenmesh-dev libcgal-dev        # manifold mesh work, exact predicates
-  python3-numpy snakemake            # exec: reference server, Snakefile
+  python3-numpy snakemake            # exec: reference server, Python package, Snakefile
+  python3-vtk9 xvfb xauth            # pictures (pipelines/render.py: VTK under a virtual X server)
 )
 
 missing=()
