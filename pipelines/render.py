@@ -73,16 +73,8 @@ def read_mesh(path):
     if not os.path.isfile(path):
         raise OSError(f"{path}: no such file")
     if ext == ".off":
-        t = open(path).read().split("\n")
-        words = [w for line in t for w in line.split("#")[0].split()]
-        assert words[0].endswith("OFF")
-        nv, nf = int(words[1]), int(words[2])
-        v = np.array(words[4:4 + 3 * nv], float).reshape(nv, 3)
-        faces, k = [], 4 + 3 * nv
-        for _ in range(nf):
-            c = int(words[k]); idx = [int(x) for x in words[k + 1:k + 1 + c]]; k += 1 + c
-            faces += [[idx[0], idx[i], idx[i + 1]] for i in range(1, c - 1)]
-        return v, np.array(faces, int).reshape(-1, 3)
+        import voroudf
+        return voroudf.read_off(path)
     if ext == ".ply":
         try:
             import voroudf

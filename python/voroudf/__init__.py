@@ -26,7 +26,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-__all__ = ["mesh", "serve", "evaluate", "read_ply", "Mesh", "Server", "StageError", "UdfError"]
+__all__ = ["mesh", "serve", "evaluate", "read_ply", "read_off", "Mesh", "Server", "StageError", "UdfError"]
 
 STAGES = ["sample-seeds", "optimize-seeds", "build-gvd", "thin-mesh"]
 
@@ -259,6 +259,23 @@ def evaluate(mesh_or_path, reference, bin_dir=None, extra=None):
     return json.loads(_run(bin_dir, "evaluate", ["-i", path, "--reference", str(reference)] + _args(extra),
                            capture_stdout=True))
 
+
+# -------------------------------------------------------------------------------------------- mesh files
+
+def read_off(path):
+    """(vertices (V,3), triangles (F,3)) of an ASCII OFF file (`#` comments; polygons split into fans)."""
+    words = [w for line in open(path) for w in line.split("#")[0].split()]
+    if not words or not words[0].endswith("OFF"):
+        raise ValueError(f"{path}: not an OFF file")
+    nv, nf = int(words[1]), int(words[2])
+    v = np.array(words[4:4 + 3 * nv], float).reshape(nv, 3)
+    faces, k = [], 4 + 3 * nv
+    for _ in range(nf):
+        c = int(words[k])
+        idx = [int(x) for x in words[k + 1:k + 1 + c]]
+        k += 1 + c
+        faces += [[idx[0], idx[i], idx[i + 1]] for i in range(1, c - 1)]
+    return v, np.array(faces, dtype=np.int64).reshape(-1, 3)
 
 # --------------------------------------------------------------------------------------------- PLY files
 
