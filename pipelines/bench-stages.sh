@@ -1,55 +1,69 @@
 #!/usr/bin/env bash
-# Per-stage wall time of the mesh chain (sample-seeds -> optimize-seeds -> build-gvd -> thin-mesh), the
-# median of REPS runs, and the output size, on shape:cube and cgal_fandisk.off at COUNT seeds. Target of
-# build-gvd + thin-mesh (issue 5): under 5 s for 3k seeds on the 2-core CI machine. Prints a Markdown table.
+# Per-stage cost of the mesh chain (sample-seeds -> optimize-seeds -> build-gvd -> thin-mesh): wall time,
+# CPU time (user + system), UDF queries and peak memory of every stage and of the whole chain, medians of
+# REPS runs (queries are the same in every run). Inputs: shape:sphere, the same sphere through the numpy
+# reference server behind exec: and behind unix: (what a learned UDF pays for the protocol), shape:cube, and
+# cgal_fandisk.off. Prints a Markdown table.
 #
 # Usage: pipelines/bench-stages.sh [BIN_DIR]      (default: build/bin in the checkout)
 #   DATA=DIR      folder of the shared meshes (default: ../shared/data beside the checkout; fandisk is
 #                 skipped when it is missing)
-#   COUNT=N       seeds (3000)    REPS=N   runs per input (3)    THREADS=N   --threads of every stage (0)
+#   COUNT=N       seeds (2500)    REPS=N   runs per input (3)    THREADS=N   --threads of every stage (0)
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 bin=${1:-$root/build/bin}
 data=${DATA:-$root/../shared/data}
-count=${COUNT:-3000}
+count=${COUNT:-2500}
 reps=${REPS:-3}
 threads=${THREADS:-0}
 for p in sample-seeds optimize-seeds build-gvd thin-mesh; do
   [ -x "$bin/$p" ] || { echo "bench-stages: $bin/$p is not built" >&2; exit 2; }
 done
 work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
+server_pid=""
+trap '[ -n "$server_pid" ] && kill "$server_pid" 2> /dev/null; rm -rf "$work"' EXIT
 
-# Runs a command quietly and prints its wall time in seconds.
+# Runs a stage quietly; appends "wall cpu peak_kb queries" to the file $1.
 timed() {
-  local t0 t1
-  t0=$(date +%s.%N)
-  "$@" -q
-  t1=$(date +%s.%N)
-  awk -v a="$t0" -v b="$t1" 'BEGIN { printf "%.3f\n", b - a }'
+  local out=$1; shift
+  /usr/bin/time -f "%e %U %S %M" -o "$work/time" "$@" -q --udf-stats "$work/stats"
+  local q
+  q=$(sed -n 2p "$work/stats" | cut -f1)
+  awk -v q="$q" '{ printf "%.3f %.3f %d %s\n", $1, $2 + $3, $4, q }' "$work/time" >> "$out"
 }
 median() { sort -g | awk '{ v[NR] = $1 } END { print (NR % 2) ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2 }'; }
-# Vertex and face counts from a PLY header.
-counts() { awk '/^element vertex/ { v = $3 } /^element face/ { f = $3 } /^end_header/ { print v, f; exit }' "$1"; }
+col() { awk -v c="$2" '{ print $c }' "$1" | median; }
 
-inputs=("shape:cube")
+/usr/bin/python3 "$root/pipelines/udf_server_sphere.py" --unix "$work/sphere.sock" &
+server_pid=$!
+for _ in $(seq 100); do [ -S "$work/sphere.sock" ] && break; sleep 0.05; done
+inputs=("shape:sphere" "exec:/usr/bin/python3 $root/pipelines/udf_server_sphere.py" "unix:$work/sphere.sock" "shape:cube")
 [ -f "$data/cad/cgal_fandisk.off" ] && inputs+=("$data/cad/cgal_fandisk.off")
 
-echo "| input | seeds | runs | s sample-seeds | s optimize-seeds | s build-gvd | s thin-mesh | s build-gvd + thin-mesh | #v | #f |"
-echo "|---|---|---|---|---|---|---|---|---|---|"
+echo "| input | stage | s wall | s CPU | UDF queries | peak MB |"
+echo "|---|---|---|---|---|---|"
 for udf in "${inputs[@]}"; do
-  : > "$work/times"
+  stages=(sample-seeds optimize-seeds build-gvd thin-mesh)
+  for s in "${stages[@]}"; do : > "$work/$s"; done
+  : > "$work/total"
   for ((r = 1; r <= reps; ++r)); do
     common=(--udf "$udf" --threads "$threads")
-    s1=$(timed "$bin/sample-seeds" "${common[@]}" --count "$count" --seed 1 -o "$work/seeds0.ply")
-    s2=$(timed "$bin/optimize-seeds" "${common[@]}" -i "$work/seeds0.ply" -o "$work/seeds.ply")
-    s3=$(timed "$bin/build-gvd" "${common[@]}" -i "$work/seeds.ply" -o "$work/thick.ply")
-    s4=$(timed "$bin/thin-mesh" "${common[@]}" -i "$work/thick.ply" -o "$work/mesh.ply")
-    echo "$s1 $s2 $s3 $s4" >> "$work/times"
+    timed "$work/sample-seeds" "$bin/sample-seeds" "${common[@]}" --count "$count" --seed 1 -o "$work/seeds0.ply"
+    timed "$work/optimize-seeds" "$bin/optimize-seeds" "${common[@]}" -i "$work/seeds0.ply" -o "$work/seeds.ply"
+    timed "$work/build-gvd" "$bin/build-gvd" "${common[@]}" -i "$work/seeds.ply" -o "$work/thick.ply"
+    timed "$work/thin-mesh" "$bin/thin-mesh" "${common[@]}" -i "$work/thick.ply" -o "$work/mesh.ply"
+    # The run's total: sums of wall, CPU and queries, the largest peak.
+    paste -d' ' "$work/sample-seeds" "$work/optimize-seeds" "$work/build-gvd" "$work/thin-mesh" | tail -1 |
+      awk '{ w = c = q = 0; m = 0; for (i = 0; i < 4; ++i) { w += $(4*i+1); c += $(4*i+2); if ($(4*i+3) > m) m = $(4*i+3); q += $(4*i+4) }
+             printf "%.3f %.3f %d %d\n", w, c, m, q }' >> "$work/total"
   done
-  cols=()
-  for c in 1 2 3 4; do cols+=("$(awk -v c=$c '{ print $c }' "$work/times" | median)"); done
-  gvd_thin=$(awk '{ print $3 + $4 }' "$work/times" | median)
-  read -r nv nf < <(counts "$work/mesh.ply")
-  echo "| $(basename "$udf") | $count | $reps | ${cols[0]} | ${cols[1]} | ${cols[2]} | ${cols[3]} | $gvd_thin | $nv | $nf |"
+  name=$(basename "${udf%% *}")
+  [[ "$udf" == exec:* ]] && name="exec: numpy sphere server"
+  [[ "$udf" == unix:* ]] && name="unix: numpy sphere server"
+  for s in "${stages[@]}" total; do
+    printf "| %s | %s | %s | %s | %s | %.0f |\n" "$name" "$s" "$(col "$work/$s" 1)" "$(col "$work/$s" 2)" \
+      "$(col "$work/$s" 4)" "$(col "$work/$s" 3 | awk '{ print $1 / 1024 }')"
+  done
 done
+echo
+echo "$count seeds, --threads $threads, medians of $reps runs (this machine: $(nproc) cores)."

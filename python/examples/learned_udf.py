@@ -3,7 +3,7 @@
 (PyTorch from Debian's python3-torch, CPU), mesh the network with voroudf.mesh, evaluate against the mesh.
 
 Usage: PYTHONPATH=python VOROUDF_BIN=build/bin /usr/bin/python3 python/examples/learned_udf.py MESH.off
-           [--seeds 2500] [--steps 3000] [--workdir DIR]
+           [--seeds 2500] [--steps 1500] [--workdir DIR]
 
 Training targets are the distances to 150k points sampled on the mesh (as NDF-style training data is made
 from point clouds), so the learned field is off by about their spacing near the surface, and its gradient
@@ -55,8 +55,11 @@ def main():
     p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     p.add_argument("mesh")
     p.add_argument("--seeds", type=int, default=2500)
-    p.add_argument("--steps", type=int, default=3000)
+    p.add_argument("--steps", type=int, default=1500)
     p.add_argument("--workdir", default="learned-udf")
+    p.add_argument("--proj-tol-rel", type=float, default=3e-3,
+                   help="projection tolerance of the stages: a learned UDF has no exact zero set, its minimum is "
+                        "about its fitting error (the programs' default, 1e-5, is for exact UDFs)")
     a = p.parse_args()
     torch.manual_seed(0)
     torch.set_num_threads(os.cpu_count() or 1)
@@ -78,13 +81,18 @@ def main():
     opt = torch.optim.Adam(model.parameters(), lr=1e-3)
     sched = torch.optim.lr_scheduler.CosineAnnealingLR(opt, a.steps)
     t0 = time.time()
-    for step in range(a.steps):
+    os.makedirs(a.workdir, exist_ok=True)
+    saved = os.path.join(a.workdir, f"model-{a.steps}.pt")  # a second run meshes the same network again
+    if os.path.exists(saved):
+        model.load_state_dict(torch.load(saved))
+    for step in range(0 if os.path.exists(saved) else a.steps):
         i = torch.randint(0, len(q), (8192,))
         loss = (model(q[i]) - d[i]).abs().mean()  # L1, as NDF
         opt.zero_grad(); loss.backward(); opt.step(); sched.step()
         if step % 500 == 0 or step == a.steps - 1:
             print(f"learned_udf: step {step} L1 {loss.item():.5f}", file=sys.stderr)
     train_s = time.time() - t0
+    torch.save(model.state_dict(), saved)
 
     def udf(x):  # (N,3) float32 in the normalised frame -> distances, autograd gradients
         out_d, out_g = [], []
@@ -96,7 +104,9 @@ def main():
         return torch.cat(out_d), torch.cat(out_g)
 
     t0 = time.time()
-    m = voroudf.mesh(udf, box=([-0.6] * 3, [0.6] * 3), seeds=a.seeds, workdir=a.workdir)
+    tol = f"--proj-tol-rel {a.proj_tol_rel}"
+    m = voroudf.mesh(udf, box=([-0.6] * 3, [0.6] * 3), seeds=a.seeds, workdir=a.workdir, sample_seeds=tol,
+                     optimize_seeds=tol, build_gvd=f"{tol} --eps-udf-rel {max(2e-3, 2 * a.proj_tol_rel)}")
     mesh_s = time.time() - t0
     # The reference in the same frame: the programs normalise the mesh the same way with --udf-normalize.
     ref = os.path.join(a.workdir, "reference.ply")
