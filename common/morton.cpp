@@ -1,5 +1,8 @@
 #include "common/morton.h"
 
+#include <omp.h>
+#include <parallel/algorithm>
+
 #include <algorithm>
 #include <cmath>
 #include <utility>
@@ -35,7 +38,12 @@ std::vector<size_t> MortonOrder(const Vec3* points, size_t count, const Box& box
   std::vector<std::pair<uint64_t, size_t>> keyed(count);
 #pragma omp parallel for schedule(static)
   for (long i = 0; i < static_cast<long>(count); ++i) keyed[i] = {MortonCode(points[i], box), i};
-  std::sort(keyed.begin(), keyed.end());
+  // Keys are unique (the index breaks ties), so the parallel sort (libstdc++'s OpenMP parallel mode) gives
+  // the same order as std::sort; large batches are sorted on every thread (5 % of optimize-seeds on one).
+  if (count >= 65536 && omp_get_max_threads() > 1 && !omp_in_parallel())
+    __gnu_parallel::sort(keyed.begin(), keyed.end());
+  else
+    std::sort(keyed.begin(), keyed.end());
   std::vector<size_t> order(count);
   for (size_t i = 0; i < count; ++i) order[i] = keyed[i].second;
   return order;
