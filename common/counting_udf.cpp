@@ -15,22 +15,20 @@ void Count(UdfUsage& usage, size_t count, std::chrono::steady_clock::time_point 
   usage.nanoseconds.fetch_add(static_cast<uint64_t>(ns), std::memory_order_relaxed);
 }
 
-}  // namespace
-
-std::string UdfUsage::Summary() const {
+// The three counters through `format` (two %llu, one %.3f).
+std::string Format(const UdfUsage& usage, const char* format) {
   char line[160];
-  std::snprintf(line, sizeof line, "%llu queries in %llu batches, %.3f s inside the UDF",
-                static_cast<unsigned long long>(queries.load()), static_cast<unsigned long long>(batches.load()),
-                1e-9 * static_cast<double>(nanoseconds.load()));
+  std::snprintf(line, sizeof line, format, static_cast<unsigned long long>(usage.queries.load()),
+                static_cast<unsigned long long>(usage.batches.load()), 1e-9 * static_cast<double>(usage.nanoseconds.load()));
   return line;
 }
 
+}  // namespace
+
+std::string UdfUsage::Summary() const { return Format(*this, "%llu queries in %llu batches, %.3f s inside the UDF"); }
+
 std::string UdfUsage::Tsv() const {
-  char line[160];
-  std::snprintf(line, sizeof line, "udf_queries\tudf_batches\tudf_seconds\n%llu\t%llu\t%.3f\n",
-                static_cast<unsigned long long>(queries.load()), static_cast<unsigned long long>(batches.load()),
-                1e-9 * static_cast<double>(nanoseconds.load()));
-  return line;
+  return Format(*this, "udf_queries\tudf_batches\tudf_seconds\n%llu\t%llu\t%.3f\n");
 }
 
 CountingUdf::CountingUdf(std::unique_ptr<Udf> inner, std::shared_ptr<UdfUsage> usage)

@@ -86,6 +86,14 @@ UdfSourceKind ClassifyUdfSpec(const std::string& spec) {
 }
 
 std::unique_ptr<Udf> OpenUdf(const std::string& spec, const UdfSourceOptions& options) {
+  // Sources whose only box is their domain are normalised by it.
+  auto by_domain = [&](std::unique_ptr<Udf> udf) {
+    if (!options.normalize) return udf;
+    const Box frame = udf->Domain();
+    return NormalizeUdf(std::move(udf), frame);
+  };
+  ExecUdfOptions exec_options;
+  exec_options.timeout_s = options.exec_timeout_s;
   switch (ClassifyUdfSpec(spec)) {
     case UdfSourceKind::kShape:
       return MakeShape(spec.substr(6));
@@ -94,28 +102,12 @@ std::unique_ptr<Udf> OpenUdf(const std::string& spec, const UdfSourceOptions& op
       mesh_options.normalize = options.normalize;  // by the mesh's own bbox, not the inflated domain
       return MeshUdf::Open(spec, mesh_options);
     }
-    case UdfSourceKind::kGrid: {
-      std::unique_ptr<Udf> grid = GridUdf::Open(spec, options.grid_box);
-      if (!options.normalize) return grid;
-      const Box frame = grid->Domain();
-      return NormalizeUdf(std::move(grid), frame);
-    }
-    case UdfSourceKind::kExec: {
-      ExecUdfOptions exec_options;
-      exec_options.timeout_s = options.exec_timeout_s;
-      std::unique_ptr<Udf> exec = std::make_unique<ExecUdf>(spec.substr(5), exec_options);
-      if (!options.normalize) return exec;
-      const Box frame = exec->Domain();
-      return NormalizeUdf(std::move(exec), frame);
-    }
-    case UdfSourceKind::kUnix: {
-      ExecUdfOptions exec_options;
-      exec_options.timeout_s = options.exec_timeout_s;
-      std::unique_ptr<Udf> socket = std::make_unique<ExecUdf>(ExecUdf::UnixSocket{spec.substr(5)}, exec_options);
-      if (!options.normalize) return socket;
-      const Box frame = socket->Domain();
-      return NormalizeUdf(std::move(socket), frame);
-    }
+    case UdfSourceKind::kGrid:
+      return by_domain(GridUdf::Open(spec, options.grid_box));
+    case UdfSourceKind::kExec:
+      return by_domain(std::make_unique<ExecUdf>(spec.substr(5), exec_options));
+    case UdfSourceKind::kUnix:
+      return by_domain(std::make_unique<ExecUdf>(ExecUdf::UnixSocket{spec.substr(5)}, exec_options));
   }
   throw InputError(spec, "unknown kind of UDF source");
 }

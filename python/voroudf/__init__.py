@@ -26,7 +26,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-__all__ = ["mesh", "serve", "evaluate", "read_ply", "read_off", "Mesh", "Server", "StageError", "UdfError"]
+__all__ = ["mesh", "serve", "evaluate", "read_ply", "read_off", "edge_counts", "Mesh", "Server", "StageError", "UdfError"]
 
 STAGES = ["sample-seeds", "optimize-seeds", "build-gvd", "thin-mesh"]
 
@@ -183,14 +183,18 @@ class Mesh:
     def euler(self):
         """χ = V − E + F (unreferenced vertices are not counted)."""
         used = np.unique(self.faces)
-        return len(used) - len(_edges(self.faces)[0]) + len(self.faces)
+        return len(used) - len(edge_counts(self.faces)[0]) + len(self.faces)
 
     def __repr__(self):
         return (f"Mesh({len(self.vertices)} vertices, {len(self.faces)} faces, "
                 f"{len(self.nonmanifold_edges)} non-manifold edges, χ = {self.euler})")
 
 
-def _edges(faces):
+def edge_counts(faces):
+    """The undirected edges of triangles (F,3) and how many triangles share each: (E,2), (E,)."""
+    faces = np.asarray(faces, dtype=np.int64).reshape(-1, 3)
+    if len(faces) == 0:
+        return np.zeros((0, 2), dtype=np.int64), np.zeros(0, dtype=np.int64)
     e = np.sort(np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]]), axis=1)
     return np.unique(e, axis=0, return_counts=True)
 
@@ -232,7 +236,7 @@ def mesh(udf, box=None, seeds=2500, seed=0, workdir=None, bin_dir=None, threads=
              + _args(thin_mesh))
         data = read_ply(f["mesh"])
         faces = data.get("face", np.zeros((0, 3), dtype=np.int64))
-        edges, counts = _edges(faces) if len(faces) else (np.zeros((0, 2), int), np.zeros(0, int))
+        edges, counts = edge_counts(faces)
         result = Mesh(data["vertex"][:, :3].astype(np.float64), faces, edges[counts >= 3],
                       dict(f) if keep else {})
     except StageError as e:
