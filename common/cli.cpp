@@ -173,7 +173,7 @@ void StageCli::CheckBeforeWork() const {
   if (udf_spec_ != nullptr) {
     if (!(udf_options_.exec_timeout_s > 0 && udf_options_.exec_timeout_s <= kMaxTimeout_s))
       throw UsageError("--udf-timeout must be in (0, 1e6] seconds");
-    if (!udf_options_.grid_box.empty() && !udf_spec_->empty() && ClassifyUdfSpec(*udf_spec_) != UdfSourceKind::kGrid)
+    if (!udf_options_.grid_box.empty() && !udf_spec_->empty() && ClassifyUdfSpec(BaseUdfSpec(*udf_spec_)) != UdfSourceKind::kGrid)
       throw UsageError("--udf-box applies to a .npy grid source only, not to '" + *udf_spec_ + "'");
   }
   int stdin_inputs = 0;

@@ -9,6 +9,7 @@
 #include "common/exec_udf.h"
 #include "common/grid_udf.h"
 #include "common/mesh_udf.h"
+#include "common/noisy_udf.h"
 #include "common/shapes.h"
 
 namespace voroudf {
@@ -74,15 +75,22 @@ std::unique_ptr<Udf> NormalizeUdf(std::unique_ptr<Udf> inner, const Box& frame) 
   return std::make_unique<NormalizedUdf>(std::move(inner), frame);
 }
 
+std::string BaseUdfSpec(const std::string& spec) {
+  std::string base = spec;
+  while (StartsWith(base, "noisy:") && base.find(':', 6) != std::string::npos) base = base.substr(base.find(':', 6) + 1);
+  return base;
+}
+
 UdfSourceKind ClassifyUdfSpec(const std::string& spec) {
   if (StartsWith(spec, "shape:")) return UdfSourceKind::kShape;
   if (StartsWith(spec, "exec:")) return UdfSourceKind::kExec;
   if (StartsWith(spec, "unix:")) return UdfSourceKind::kUnix;
+  if (StartsWith(spec, "noisy:")) return UdfSourceKind::kNoisy;
   const std::string ext = LowerExtension(spec);
   if (ext == "obj" || ext == "off" || ext == "ply" || ext == "stl") return UdfSourceKind::kMesh;
   if (ext == "npy") return UdfSourceKind::kGrid;
   throw InputError("--udf '" + spec +
-                   "': expected shape:NAME, a mesh (.obj .off .ply .stl), a grid (.npy), exec:COMMAND or unix:SOCKET");
+                   "': expected shape:NAME, a mesh (.obj .off .ply .stl), a grid (.npy), exec:COMMAND, unix:SOCKET or noisy:OPTIONS:SPEC");
 }
 
 std::unique_ptr<Udf> OpenUdf(const std::string& spec, const UdfSourceOptions& options) {
@@ -108,6 +116,14 @@ std::unique_ptr<Udf> OpenUdf(const std::string& spec, const UdfSourceOptions& op
       return by_domain(std::make_unique<ExecUdf>(spec.substr(5), exec_options));
     case UdfSourceKind::kUnix:
       return by_domain(std::make_unique<ExecUdf>(ExecUdf::UnixSocket{spec.substr(5)}, exec_options));
+    case UdfSourceKind::kNoisy: {
+      // The options end at the first ':'; the rest is the inner SPEC (which may itself contain ':').
+      const auto colon = spec.find(':', 6);
+      if (colon == std::string::npos)
+        throw UsageError("--udf '" + spec + "': expected noisy:OPTIONS:SPEC, e.g. noisy:value=1e-3,grad=15:shape:cube");
+      const UdfNoise noise = ParseUdfNoise(spec.substr(6, colon - 6));
+      return MakeNoisyUdf(OpenUdf(spec.substr(colon + 1), options), noise);
+    }
   }
   throw InputError(spec, "unknown kind of UDF source");
 }

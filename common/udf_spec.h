@@ -8,7 +8,7 @@
 namespace voroudf {
 
 /// What kind of source a SPEC names (by prefix or file extension).
-enum class UdfSourceKind { kShape, kMesh, kGrid, kExec, kUnix };
+enum class UdfSourceKind { kShape, kMesh, kGrid, kExec, kUnix, kNoisy };
 
 /// Options that apply to some sources (set from the common CLI flags).
 struct UdfSourceOptions {
@@ -23,7 +23,11 @@ struct UdfSourceOptions {
 /// Classifies a SPEC; throws InputError (exit 3) for one that names no known kind of source.
 UdfSourceKind ClassifyUdfSpec(const std::string& spec);
 
-/// Opens the source named by `spec`: "shape:NAME", "path.{obj,off,ply,stl}", "path.npy", "exec:COMMAND".
+/// The SPEC without its noisy:OPTIONS: wrappers (the source the field comes from).
+std::string BaseUdfSpec(const std::string& spec);
+
+/// Opens the source named by `spec`: "shape:NAME", "path.{obj,off,ply,stl}", "path.npy", "exec:COMMAND",
+/// "unix:SOCKET", "noisy:OPTIONS:SPEC" (common/noisy_udf.h).
 /// Throws InputError (exit 3) when the source cannot be opened or is malformed, UsageError (exit 2) for a
 /// malformed --udf-box.
 std::unique_ptr<Udf> OpenUdf(const std::string& spec, const UdfSourceOptions& options = {});

@@ -1,0 +1,129 @@
+// noisy:OPTIONS:SPEC (common/noisy_udf.h): the value error has the asked spread and is smooth, the gradient is
+// turned by exactly the asked angle, the field is a function of the point alone (batching, order and threads
+// do not change it; the seed does), no noise is the inner field bit for bit, and bad options are refused.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "common/errors.h"
+#include "common/noisy_udf.h"
+#include "common/rng.h"
+#include "common/udf_spec.h"
+
+namespace voroudf {
+namespace {
+
+std::vector<Vec3> RandomPoints(size_t n, uint64_t seed) {
+  Rng rng(seed, 1);
+  std::vector<Vec3> p(n);
+  for (auto& x : p) x = Vec3(rng.Uniform(-0.6, 0.6), rng.Uniform(-0.6, 0.6), rng.Uniform(-0.6, 0.6));
+  return p;
+}
+
+TEST(NoisyUdf, ValueErrorHasTheAskedSpreadAndIsSmooth) {
+  const auto exact = OpenUdf("shape:sphere");
+  const auto noisy = OpenUdf("noisy:value=1e-3,scale=0.05:shape:sphere");
+  const double sigma = 1e-3 * exact->Domain().Diagonal();
+  const auto points = RandomPoints(20000, 3);
+  std::vector<double> d0, d1;
+  std::vector<Vec3> g0, g1;
+  exact->Evaluate(points, d0, g0);
+  noisy->Evaluate(points, d1, g1);
+  double sum = 0, sum2 = 0;
+  int n = 0;
+  for (size_t i = 0; i < points.size(); ++i) {
+    if (d0[i] < 10 * sigma) continue;  // away from the fold of |d + e|
+    const double e = d1[i] - d0[i];
+    sum += e, sum2 += e * e, ++n;
+    EXPECT_EQ(g1[i], g0[i]);  // value noise alone leaves the gradient where d + e > 0
+  }
+  ASSERT_GT(n, 15000);
+  const double mean = sum / n, sd = std::sqrt(sum2 / n - mean * mean);
+  EXPECT_NEAR(sd / sigma, 1.0, 0.1);
+  EXPECT_LT(std::abs(mean) / sigma, 0.1);
+  // Smooth: 1e-4 of the correlation length apart, the error moves by a tiny fraction of sigma; 3 lengths
+  // apart it is nearly independent.
+  const double length = 0.05 * exact->Domain().Diagonal();
+  double near_change = 0, far_corr = 0;
+  int m = 0;
+  for (size_t i = 0; i < 2000; ++i) {
+    const Vec3 p = points[i];
+    const Vec3 q = p + Vec3(1, 2, 3).normalized() * 1e-4 * length, r = p + Vec3(3, -1, 2).normalized() * 3 * length;
+    if (exact->Distance(p) < 10 * sigma || exact->Distance(q) < 10 * sigma || exact->Distance(r) < 10 * sigma) continue;
+    const double ep = noisy->Distance(p) - exact->Distance(p), eq = noisy->Distance(q) - exact->Distance(q),
+                 er = noisy->Distance(r) - exact->Distance(r);
+    near_change = std::max(near_change, std::abs(ep - eq));
+    far_corr += ep * er / (sigma * sigma), ++m;
+  }
+  EXPECT_LT(near_change, 0.01 * sigma);
+  EXPECT_LT(std::abs(far_corr / m), 0.1);
+}
+
+TEST(NoisyUdf, GradientIsTurnedByExactlyTheAskedAngle) {
+  const auto exact = OpenUdf("shape:cube");
+  const auto noisy = OpenUdf("noisy:grad=15:shape:cube");
+  const auto points = RandomPoints(5000, 4);
+  std::vector<double> d0, d1;
+  std::vector<Vec3> g0, g1;
+  exact->Evaluate(points, d0, g0);
+  noisy->Evaluate(points, d1, g1);
+  double turned_min = 180, turned_max = 0;
+  Vec3 mean_turn = Vec3::Zero();
+  for (size_t i = 0; i < points.size(); ++i) {
+    EXPECT_EQ(d1[i], d0[i]);
+    EXPECT_NEAR(g1[i].norm(), 1.0, 1e-12);
+    const double deg = std::acos(std::clamp(g1[i].dot(g0[i]), -1.0, 1.0)) * 180 / M_PI;
+    turned_min = std::min(turned_min, deg), turned_max = std::max(turned_max, deg);
+    mean_turn += g1[i] - g0[i].dot(g1[i]) * g0[i];
+  }
+  EXPECT_NEAR(turned_min, 15.0, 1e-6);
+  EXPECT_NEAR(turned_max, 15.0, 1e-6);
+  EXPECT_LT(mean_turn.norm() / points.size(), 0.05);  // no preferred direction
+}
+
+TEST(NoisyUdf, AFunctionOfThePointAndTheSeedOnly) {
+  const auto noisy = OpenUdf("noisy:value=3e-3,grad=30,seed=7:shape:three-discs");
+  const auto points = RandomPoints(10000, 5);
+  std::vector<double> whole;
+  std::vector<Vec3> whole_g;
+  noisy->Evaluate(points, whole, whole_g);
+  for (size_t i = 0; i < points.size(); i += 997) {  // one at a time, in another order
+    Vec3 g;
+    const double d = noisy->Distance(points[points.size() - 1 - i], &g);
+    EXPECT_EQ(d, whole[points.size() - 1 - i]);
+    EXPECT_EQ(g, whole_g[points.size() - 1 - i]);
+  }
+  const auto other = OpenUdf("noisy:value=3e-3,grad=30,seed=8:shape:three-discs");
+  std::vector<double> d2;
+  std::vector<Vec3> g2;
+  other->Evaluate(points, d2, g2);
+  int differ = 0;
+  for (size_t i = 0; i < points.size(); ++i) differ += d2[i] != whole[i];
+  EXPECT_GT(differ, 9900);
+}
+
+TEST(NoisyUdf, NoNoiseIsTheInnerField) {
+  const auto exact = OpenUdf("shape:torus");
+  const auto noisy = OpenUdf("noisy:value=0,grad=0:shape:torus");
+  const auto points = RandomPoints(3000, 6);
+  std::vector<double> d0, d1;
+  std::vector<Vec3> g0, g1;
+  exact->Evaluate(points, d0, g0);
+  noisy->Evaluate(points, d1, g1);
+  EXPECT_EQ(d0, d1);
+  EXPECT_EQ(g0, g1);
+  EXPECT_EQ(noisy->Domain().min, exact->Domain().min);
+  EXPECT_NE(noisy->Describe().find("noisy"), std::string::npos);
+  EXPECT_EQ(BaseUdfSpec("noisy:value=1e-3:noisy:grad=5:grid.npy"), "grid.npy");
+}
+
+TEST(NoisyUdf, BadOptionsAreRefused) {
+  for (const char* spec : {"noisy:value=1e-3", "noisy:value=-1:shape:cube", "noisy:grad=91:shape:cube",
+                           "noisy:scale=0:shape:cube", "noisy:sigma=1:shape:cube", "noisy:value=abc:shape:cube",
+                           "noisy:seed=1.5:shape:cube", "noisy:value:shape:cube"})
+    EXPECT_THROW(OpenUdf(spec), UsageError) << spec;
+  EXPECT_THROW(OpenUdf("noisy:value=1e-3:shape:nothing"), InputError);
+}
+
+}  // namespace
+}  // namespace voroudf
