@@ -16,6 +16,10 @@ ProjectionResult ProjectToZeroSet(const Udf& udf, std::vector<Vec3>& points, con
 
   std::vector<size_t> active(n);
   for (size_t i = 0; i < n; ++i) active[i] = i;
+  // Per point: the gradient its last ordinary step followed (zero before the first), and whether the last
+  // move went to a kink's bottom.
+  std::vector<Vec3> stepped_along(n, Vec3::Zero());
+  std::vector<char> at_kink(n, 0);
   std::vector<Vec3> batch;
   std::vector<double> d;
   std::vector<Vec3> g;
@@ -29,12 +33,20 @@ ProjectionResult ProjectToZeroSet(const Udf& udf, std::vector<Vec3>& points, con
       const size_t i = active[k];
       result.distance[i] = d[k];
       result.gradient[i] = g[k];
-      if (d[k] < options.tolerance) {
+      if (d[k] < options.tolerance || (at_kink[i] && d[k] < options.floor_tolerance)) {
         result.converged[i] = 1;
+        result.num_at_floor += d[k] >= options.tolerance;
         continue;
       }
       if (iter == options.max_iterations || !std::isfinite(d[k]) || g[k].squaredNorm() < 0.25) continue;
-      points[i] -= d[k] * g[k];
+      if (!at_kink[i] && options.floor_tolerance > 0 && g[k].dot(stepped_along[i]) < 0) {
+        points[i] += 0.5 * d[k] * stepped_along[i];  // back to the kink's bottom (see the header)
+        at_kink[i] = 1;
+      } else {
+        points[i] -= d[k] * g[k];
+        stepped_along[i] = g[k];
+        at_kink[i] = 0;
+      }
       if (!domain.Contains(points[i], escape)) continue;
       still.push_back(i);
     }

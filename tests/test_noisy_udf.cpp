@@ -1,4 +1,5 @@
-// noisy:OPTIONS:SPEC (common/noisy_udf.h): the value error has the asked spread and is smooth, the gradient is
+// noisy:OPTIONS:SPEC (common/noisy_udf.h) and projection onto fields with a floor (common/projection.h).
+// The wrapper: the value error has the asked spread and is smooth, the gradient is
 // turned by exactly the asked angle, the field is a function of the point alone (batching, order and threads
 // do not change it; the seed does), no noise is the inner field bit for bit, and bad options are refused.
 #include <gtest/gtest.h>
@@ -7,8 +8,10 @@
 
 #include "common/errors.h"
 #include "common/noisy_udf.h"
+#include "common/projection.h"
 #include "common/rng.h"
 #include "common/udf_spec.h"
+#include "stages/sample-seeds/sample_seeds.h"
 
 namespace voroudf {
 namespace {
@@ -123,6 +126,65 @@ TEST(NoisyUdf, BadOptionsAreRefused) {
                            "noisy:seed=1.5:shape:cube", "noisy:value:shape:cube"})
     EXPECT_THROW(OpenUdf(spec), UsageError) << spec;
   EXPECT_THROW(OpenUdf("noisy:value=1e-3:shape:nothing"), InputError);
+}
+
+// d = |z| + floor: a sheet whose field never reaches zero, as a learned UDF's.
+class FloorPlane : public Udf {
+ public:
+  explicit FloorPlane(double floor) : floor_(floor) {}
+  void EvaluateChunk(const Vec3* p, size_t count, double* d, Vec3* g) const override {
+    for (size_t i = 0; i < count; ++i) {
+      d[i] = std::abs(p[i].z()) + floor_;
+      g[i] = Vec3(0, 0, p[i].z() < 0 ? -1 : 1);
+    }
+  }
+  Box Domain() const override { return {Vec3::Constant(-1), Vec3::Constant(1)}; }
+  std::string Describe() const override { return "floor plane"; }
+
+ private:
+  double floor_;
+};
+
+TEST(Projection, ReachesTheBottomOfAFieldWithAFloorOnlyWhenAllowed) {
+  const FloorPlane udf(1e-3);
+  Rng rng(9, 0);
+  std::vector<Vec3> start(500);
+  for (auto& p : start) p = Vec3(rng.Uniform(-0.5, 0.5), rng.Uniform(-0.5, 0.5), rng.Uniform(-0.3, 0.3));
+  ProjectionOptions options;
+  options.tolerance = 1e-9;
+  std::vector<Vec3> points = start;
+  EXPECT_EQ(ProjectToZeroSet(udf, points, options, Monitor::Null()).num_converged, 0u);  // it oscillates
+  options.floor_tolerance = 2e-3;
+  points = start;
+  const ProjectionResult r = ProjectToZeroSet(udf, points, options, Monitor::Null());
+  EXPECT_EQ(r.num_converged, start.size());
+  EXPECT_EQ(r.num_at_floor, start.size());
+  for (size_t i = 0; i < points.size(); ++i) {
+    EXPECT_LT(std::abs(points[i].z()), 1e-12);
+    EXPECT_EQ(points[i].x(), start[i].x());
+  }
+  options.floor_tolerance = 5e-4;  // below the floor: refused
+  points = start;
+  EXPECT_EQ(ProjectToZeroSet(udf, points, options, Monitor::Null()).num_converged, 0u);
+}
+
+TEST(Projection, SeedsOfANoisySphereAreKeptAndNearIt) {
+  SampleSeedsOptions options;
+  options.count = 1000;
+  const auto exact = OpenUdf("shape:sphere");
+  std::vector<Vec3> points(1, Vec3(0.3, 0.2, 0.1));
+  ProjectionOptions projection;
+  projection.tolerance = 1e-5 * exact->Domain().Diagonal();
+  projection.floor_tolerance = 1e-2 * exact->Domain().Diagonal();
+  EXPECT_EQ(ProjectToZeroSet(*exact, points, projection, Monitor::Null()).num_at_floor, 0u);  // exact: never
+
+  const auto noisy = OpenUdf("noisy:value=1e-3:shape:sphere");
+  const double sigma = 1e-3 * noisy->Domain().Diagonal();
+  const SeedCloud seeds = SampleSeeds(*noisy, options, Monitor::Null());
+  EXPECT_GE(seeds.size(), 990u);  // without the floor rule about half are dropped
+  for (size_t i = 0; i < seeds.size(); ++i) EXPECT_LT(std::abs(seeds.position[i].norm() - 0.5), 5 * sigma);
+  options.proj_floor_rel = 0;
+  EXPECT_LT(SampleSeeds(*noisy, options, Monitor::Null()).size(), 700u);
 }
 
 }  // namespace

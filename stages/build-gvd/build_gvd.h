@@ -45,6 +45,7 @@ struct BuildGvdOptions {
   uint64_t seed = 0;           ///< RNG seed of the dense samples (--seed)
   double proj_tol_rel = 1e-5;  ///< samples converge once d < proj_tol_rel * diagonal (--proj-tol-rel)
   int proj_max_iters = 50;     ///< projection steps before a sample is dropped (--proj-max-iters)
+  double proj_floor_rel = 1e-2;  ///< a kink's bottom with d below this x diagonal is on the zero set (--proj-floor-rel)
 
   /// Throws UsageError for values that cannot work.
   void Check() const;

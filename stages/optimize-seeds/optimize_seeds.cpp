@@ -41,6 +41,7 @@ void OptimizeSeedsOptions::Check() const {
   if (!(move_tol >= 0.0 && move_tol < 1.0)) throw UsageError("--move-tol must be in [0, 1)");
   if (!(outer_tol >= 0.0 && outer_tol < 1.0)) throw UsageError("--outer-tol must be in [0, 1)");
   if (!(proj_tol_rel > 0.0 && proj_tol_rel < 0.1)) throw UsageError("--proj-tol-rel must be in (0, 0.1)");
+  if (!(proj_floor_rel >= 0.0 && proj_floor_rel < 0.1)) throw UsageError("--proj-floor-rel must be in [0, 0.1)");
   if (proj_max_iters < 1) throw UsageError("--proj-max-iters must be at least 1");
 }
 
@@ -136,6 +137,7 @@ class Optimizer {
     cell_options_.early_samples = options.early_samples;
     cell_options_.early_rank_threshold = 0.5 * options.rank_threshold;
     projection_.tolerance = options.proj_tol_rel * diagonal_;
+    projection_.floor_tolerance = options.proj_floor_rel * diagonal_;
     projection_.max_iterations = options.proj_max_iters;
   }
 
@@ -685,6 +687,7 @@ SeedCloud OptimizeSeeds(const Udf& udf, const SeedCloud& input, const OptimizeSe
   Optimizer opt(udf, options, monitor);
   ProjectionOptions projection;
   projection.tolerance = options.proj_tol_rel * opt.diagonal();
+  projection.floor_tolerance = options.proj_floor_rel * opt.diagonal();
   projection.max_iterations = options.proj_max_iters;
   State s = Prepare(udf, input, projection, monitor);
   const size_t n = s.position.size();

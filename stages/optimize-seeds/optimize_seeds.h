@@ -46,6 +46,7 @@ struct OptimizeSeedsOptions {
   double outer_tol = 0.02;        ///< outer loop ends when σ does not grow and the spacing CV drops by less than this, relatively (--outer-tol)
   double proj_tol_rel = 1e-5;     ///< projection tolerance on d, relative to the diagonal (as sample-seeds) (--proj-tol-rel)
   int proj_max_iters = 50;        ///< projection steps before a move is undone (--proj-max-iters)
+  double proj_floor_rel = 1e-2;   ///< a kink's bottom with d below this x diagonal is on the zero set (as sample-seeds) (--proj-floor-rel)
 
   /// Throws UsageError for values that cannot work.
   void Check() const;

@@ -16,6 +16,7 @@ void SampleSeedsOptions::Check() const {
   if (count == 0) throw UsageError("--count must be at least 1");
   if (count > 100000000) throw UsageError("--count must be at most 1e8");
   if (!(proj_tol_rel > 0.0 && proj_tol_rel < 0.1)) throw UsageError("--proj-tol-rel must be in (0, 0.1)");
+  if (!(proj_floor_rel >= 0.0 && proj_floor_rel < 0.1)) throw UsageError("--proj-floor-rel must be in [0, 0.1)");
   if (proj_max_iters < 1) throw UsageError("--proj-max-iters must be at least 1");
   if (!(band_rel >= 0.0)) throw UsageError("--band-rel must be >= 0");
   if (!(dedup_rel >= 0.0 && dedup_rel < 0.1)) throw UsageError("--dedup-rel must be in [0, 0.1)");
@@ -110,6 +111,7 @@ SeedCloud SampleSeeds(const Udf& udf, const SampleSeedsOptions& options, Monitor
   std::vector<Vec3> points = DrawInBand(udf, box, options, monitor);
   ProjectionOptions proj;
   proj.tolerance = options.proj_tol_rel * box.Diagonal();
+  proj.floor_tolerance = options.proj_floor_rel * box.Diagonal();
   proj.max_iterations = options.proj_max_iters;
   const ProjectionResult r = ProjectToZeroSet(udf, points, proj, monitor);
 
@@ -126,9 +128,12 @@ SeedCloud SampleSeeds(const Udf& udf, const SampleSeedsOptions& options, Monitor
     seeds.udf[k] = r.distance[kept[k]];
   }
   const size_t dropped = points.size() - r.num_converged;
-  char line[200];
-  std::snprintf(line, sizeof line, "%zu of %zu seeds projected to d < %.3g; %zu dropped (not converged in %d steps)",
-                r.num_converged, points.size(), proj.tolerance, dropped, proj.max_iterations);
+  char line[300];
+  std::snprintf(line, sizeof line,
+                "%zu of %zu seeds projected to d < %.3g (%zu of them at a kink's bottom with d < %.3g); %zu dropped "
+                "(not converged in %d steps)",
+                r.num_converged, points.size(), proj.tolerance, r.num_at_floor, proj.floor_tolerance, dropped,
+                proj.max_iterations);
   if (dropped > 0) monitor.Warn(line);
   else monitor.Info(line);
   if (kept.size() < converged.size()) {

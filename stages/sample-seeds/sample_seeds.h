@@ -23,6 +23,9 @@ struct SampleSeedsOptions {
   double dedup_rel = 1e-4;
   double proj_tol_rel = 1e-5;   ///< converged once d(x) < proj_tol_rel * domain diagonal (--proj-tol-rel)
   int proj_max_iters = 50;      ///< projection steps before a seed is dropped (--proj-max-iters)
+  /// --proj-floor-rel: a seed at the bottom of a kink of d (common/projection.h) with d below this x diagonal
+  /// has converged: learned and sampled fields have such a floor instead of zeros. 0: off.
+  double proj_floor_rel = 1e-2;
 
   /// Throws UsageError for values that cannot work.
   void Check() const;
