@@ -29,7 +29,8 @@ struct BuildGvdOptions {
   /// seed spacing on a sheet) (--ball-scale).
   double ball_scale = 1.0;
   int knn = 20;  ///< neighbours per sample in the graph (--knn; paper: 20)
-  /// An edge is pruned when the UDF at its midpoint exceeds eps_udf_rel * domain diagonal (--eps-udf-rel).
+  /// An edge is pruned when the UDF at its midpoint exceeds the larger of its ends' by more than eps_udf_rel *
+  /// domain diagonal (--eps-udf-rel).
   double eps_udf_rel = 2e-3;
   /// An edge is pruned when |cos(edge, gradient)| at either endpoint exceeds this (--eps-grad).
   double eps_grad = 0.97;
