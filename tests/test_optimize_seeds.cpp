@@ -57,6 +57,49 @@ L1TangentOptions Tight() {
   return o;
 }
 
+// Normals of a cell: `planes` unit normals, each turned by `deg` degrees in a random direction.
+std::vector<Vec3> TurnedNormals(const std::vector<Vec3>& planes, double deg, int per_plane, Rng& rng) {
+  std::vector<Vec3> out;
+  for (const Vec3& n : planes)
+    for (int m = 0; m < per_plane; ++m) {
+      const Vec3 t = n.unitOrthogonal(), u = n.cross(t);
+      const double phi = rng.Uniform(0, 2 * M_PI), a = deg * M_PI / 180;
+      out.push_back(std::cos(a) * n + std::sin(a) * (std::cos(phi) * t + std::sin(phi) * u));
+    }
+  return out;
+}
+
+TEST(TangentRank, TheUnexplainedSpreadIsTakenOutOfTheRankTest) {
+  Rng rng(3, 0);
+  const Vec3 z(0, 0, 1), x(1, 0, 0);
+  std::vector<TangentRank> sheets, creases;
+  for (int c = 0; c < 40; ++c) {
+    const auto sheet = TurnedNormals({z}, 30, 100, rng), crease = TurnedNormals({z, x}, 30, 50, rng);
+    sheets.push_back(ComputeTangentRank(sheet.data(), sheet.size(), 0.4));
+    creases.push_back(ComputeTangentRank(crease.data(), crease.size(), 0.4));
+  }
+  EXPECT_EQ(sheets[0].rank, 2);  // the paper's test takes a sheet with 30-degree gradient errors for a crease
+  std::vector<TangentRank> all = sheets;
+  all.insert(all.end(), creases.begin(), creases.end() - 10);  // mostly sheets, as surfaces are
+  const double spread = UnexplainedNormalSpread(all);
+  EXPECT_NEAR(spread, std::sin(M_PI / 6) / std::sqrt(2.0), 0.05);
+  for (TangentRank r : sheets) {
+    RecountRank(r, 0.4, spread);
+    EXPECT_EQ(r.rank, 1);
+  }
+  for (TangentRank r : creases) {
+    RecountRank(r, 0.4, spread);
+    EXPECT_EQ(r.rank, 2);
+  }
+  // Exact normals: no spread, the paper's test.
+  std::vector<TangentRank> exact;
+  for (int c = 0; c < 10; ++c) {
+    const auto sheet = TurnedNormals({z}, 0, 100, rng);
+    exact.push_back(ComputeTangentRank(sheet.data(), sheet.size(), 0.4));
+  }
+  EXPECT_LT(UnexplainedNormalSpread(exact), 1e-7);
+}
+
 TEST(L1Tangent, TwoPlanesPutTheOptimumOnTheirEdge) {
   const Vec3 x0(0.02, -0.03, 0.04);
   const auto p = PlanesProblem({Vec3::UnitX(), Vec3::UnitY()}, x0, 50, 10.0);

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 
+
 namespace voroudf {
 
 void L1TangentProblem::AddTerm(const Vec3& a_m, double b_m, double tolerance) {
@@ -274,6 +275,25 @@ TangentRank ComputeTangentRank(const Vec3* normals, size_t count, double tau) {
   for (int k = 0; k < 3; ++k)
     if (result.singular_values[k] > tau * result.singular_values[0]) ++result.rank;
   return result;
+}
+
+double UnexplainedNormalSpread(const std::vector<TangentRank>& ranks) {
+  std::vector<double> ratio;
+  ratio.reserve(ranks.size());
+  for (const TangentRank& r : ranks)
+    if (r.rank > 0 && r.singular_values[0] > 0.0) ratio.push_back(r.singular_values[2] / r.singular_values[0]);
+  if (ratio.empty()) return 0.0;
+  auto mid = ratio.begin() + static_cast<std::ptrdiff_t>(ratio.size() / 2);
+  std::nth_element(ratio.begin(), mid, ratio.end());
+  return *mid;
+}
+
+void RecountRank(TangentRank& r, double tau, double spread) {
+  if (r.rank == 0) return;
+  const double threshold = std::sqrt(tau * tau + spread * spread) * r.singular_values[0];
+  r.rank = 0;
+  for (int k = 0; k < 3; ++k)
+    if (r.singular_values[k] > threshold) ++r.rank;
 }
 
 }  // namespace voroudf

@@ -90,4 +90,15 @@ struct TangentRank {
 /// \pre 0 < tau < 1
 TangentRank ComputeTangentRank(const Vec3* normals, size_t count, double tau);
 
+/// The spread of sample normals that no surface explains, ν: the median over cells of s₃/s₁. A sheet or a
+/// crease leaves s₃ = 0 with exact gradients; gradient errors (a learned field's) add about the same ν to
+/// every singular value below s₁, in every cell, so the median over a surface that is mostly sheets and
+/// creases measures them. Cells with no usable sample are skipped; 0 if none is left.
+double UnexplainedNormalSpread(const std::vector<TangentRank>& ranks);
+
+/// Sets r.rank = #{k : s_k > sqrt(tau² + spread²) s₁}: s_k² - ν² s₁² > τ² s₁², the rank test of the paper
+/// (Eq. particle_proj, threshold τ) applied to what remains once the unexplained spread is taken out.
+/// spread = 0 is the paper's test.
+void RecountRank(TangentRank& r, double tau, double spread);
+
 }  // namespace voroudf

@@ -30,6 +30,7 @@ int main(int argc, char** argv) {
   app.add_option("--max-inner-iters", o.max_inner_iters, "cap on repulsion rounds per outer iteration");
   app.add_option("--lbfgs-max-iters", o.lbfgs_max_iters, "L-BFGS iterations per repulsion round");
   app.add_option("--rank-threshold", o.rank_threshold, "rank(A) counts singular values above this fraction of the largest");
+  app.add_option("--rank-noise", o.rank_noise, "take the normal spread no surface explains (gradient errors) out of the rank test");
   app.add_option("--cell-knn", o.cell_knn, "cells are bounded by a ball sized by the distance to this nearest seed");
   app.add_option("--cell-radius-factor", o.cell_radius_factor, "ball radius / distance to the --cell-knn-th seed");
   app.add_option("--sigma-max-spacing", o.sigma_max_spacing, "kernel width at most this x mean seed spacing (0: no cap)");

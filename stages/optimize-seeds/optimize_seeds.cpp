@@ -234,10 +234,19 @@ class Optimizer {
     CellSamples cells = SampleVoronoiCells(udf_, s.position, index, cell_options, options_.seed, round_++,
                                            cached_positions_.empty() ? nullptr : &cached_cells_, &cached_positions_);
     const long n = static_cast<long>(s.position.size());
+    std::vector<TangentRank> ranks(static_cast<size_t>(n));
 #pragma omp parallel for schedule(static)
     for (long i = 0; i < n; ++i) {
       const size_t begin = cells.sample_offset[i], end = cells.sample_offset[i + 1];
-      TangentRank r = ComputeTangentRank(cells.gradient.data() + begin, end - begin, options_.rank_threshold);
+      ranks[static_cast<size_t>(i)] =
+          ComputeTangentRank(cells.gradient.data() + begin, end - begin, options_.rank_threshold);
+    }
+    // Gradient errors spread every cell's normals alike; the rank test counts only what the surface adds.
+    normal_spread_ = options_.rank_noise ? UnexplainedNormalSpread(ranks) : 0.0;
+#pragma omp parallel for schedule(static)
+    for (long i = 0; i < n; ++i) {
+      TangentRank& r = ranks[static_cast<size_t>(i)];
+      RecountRank(r, options_.rank_threshold, normal_spread_);
       MoveSpace& space = s.space[i];
       if (r.rank == 0) {
         // No usable sample (an empty cell within the budget): move in the tangent plane of the seed's own
@@ -537,6 +546,7 @@ class Optimizer {
   double diagonal() const { return diagonal_; }
   size_t last_short_cells() const { return last_short_cells_; }
   double last_acceptance() const { return last_acceptance_; }
+  double normal_spread() const { return normal_spread_; }
 
  private:
   const Udf& udf_;
@@ -550,6 +560,7 @@ class Optimizer {
   std::vector<Vec3> cached_positions_;
   size_t last_short_cells_ = 0;
   double last_acceptance_ = 0.0;
+  double normal_spread_ = 0.0;  ///< the last Analyze's UnexplainedNormalSpread (0 with --rank-noise off)
 };
 
 SeedCloud ToCloud(const State& s) {
@@ -762,8 +773,8 @@ SeedCloud OptimizeSeeds(const Udf& udf, const SeedCloud& input, const OptimizeSe
                         report.inner_rounds) +
                  "ranks 0/1/2/3: " + std::to_string(report.rank_count[0]) + "/" + std::to_string(report.rank_count[1]) +
                  "/" + std::to_string(report.rank_count[2]) + "/" + std::to_string(report.rank_count[3]) +
-                 Format(", spacing CV %.3f, cell acceptance %.2f, %.2f s", report.spacing_cv, opt.last_acceptance(),
-                        report.seconds));
+                 Format(", spacing CV %.3f, cell acceptance %.2f, normal spread %.3f, %.2f s", report.spacing_cv,
+                        opt.last_acceptance(), opt.normal_spread(), report.seconds));
     if (on_iteration) on_iteration(report, ToCloud(s));
     if (report.max_inner_move <= options.move_tol * report.sigma) {
       monitor.Info("converged: the inner loop made no update");

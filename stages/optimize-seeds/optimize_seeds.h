@@ -23,6 +23,10 @@ struct OptimizeSeedsOptions {
   int max_inner_iters = 10;       ///< cap on Alg. 1's inner loop (--max-inner-iters)
   int lbfgs_max_iters = 50;       ///< L-BFGS iterations per inner round (Ceres' default) (--lbfgs-max-iters)
   double rank_threshold = 0.4;    ///< τ: rank(A) = #{singular values > τ·s_1} (--rank-threshold)
+  /// --rank-noise: the rank test counts s_k > sqrt(τ² + ν²)·s_1, ν the median s_3/s_1 over the cells (the normal
+  /// spread no surface explains: gradient errors), so that a noisy sheet is not a crease; off (default): the
+  /// paper's test. Off by default: on feature-dense parts the median s_3/s_1 is geometry, not noise (docs).
+  bool rank_noise = false;
   int cell_knn = 6;               ///< the cell's bounding ball has radius cell_radius_factor × distance to the k-th nearest seed (--cell-knn)
   double cell_radius_factor = 0.5;///< (--cell-radius-factor)
   double sigma_max_spacing = 0.5; ///< σ ≤ this × mean nearest-neighbour distance; 0: no cap (--sigma-max-spacing)
