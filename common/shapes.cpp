@@ -203,6 +203,8 @@ const std::vector<ShapeEntry>& Shapes() {
       {"three-discs", "discs of radius 0.5 in the planes x=0, y=0, z=0 (non-manifold axes)",
        [=] { return Parts(MakeDisc(o, z, 0.5), MakeDisc(o, x, 0.5), MakeDisc(o, y, 0.5)); }},
       {"torus", "torus around z, radii 0.35 and 0.15 (genus 1)", [=] { return Parts(MakeTorus(0.35, 0.15)); }},
+      {"sphere-ring", "sphere of radius 0.35 inside a thin ring: torus around z, radii 0.48 and 0.03 (thin part)",
+       [=] { return Parts(MakeSphere(o, 0.35), MakeTorus(0.48, 0.03)); }},
   };
   return shapes;
 }
@@ -243,6 +245,7 @@ ShapeTopology KnownTopology(const std::string& name) {
   if (name == "sphere" || name == "cube") t.euler = 2;
   else if (name == "disc" || name == "hemisphere") t.euler = 1;
   else if (name == "torus") t.euler = 0;
+  else if (name == "sphere-ring") t.euler = 2 + 0;  // two components: a sphere and a torus
   else if (name == "crossing-planes") {
     t.euler = 1 + 1 - 1;  // two squares, one common segment
     t.branching_curves = {Segment(Vec3(0, -0.5, 0), Vec3(0, 0.5, 0))};

@@ -15,7 +15,7 @@ namespace {
 using test::RunProgram;
 using test::TempDir;
 
-const char* kShapes[] = {"sphere", "cube", "disc", "hemisphere", "crossing-planes", "sphere-disc", "three-discs", "torus"};
+const char* kShapes[] = {"sphere", "cube", "disc", "hemisphere", "crossing-planes", "sphere-disc", "three-discs", "torus", "sphere-ring"};
 
 TEST(SampleSeeds, EverySeedIsOnTheSurfaceForEveryShape) {
   for (const char* name : kShapes) {

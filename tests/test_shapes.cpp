@@ -35,6 +35,7 @@ double HemisphereD(const Vec3& p) {
   return std::hypot(std::hypot(p.x(), p.y()) - 0.5, p.z());  // below the cut: distance to the rim circle
 }
 double TorusD(const Vec3& p) { return std::abs(std::hypot(std::hypot(p.x(), p.y()) - 0.35, p.z()) - 0.15); }
+double RingD(const Vec3& p) { return std::abs(std::hypot(std::hypot(p.x(), p.y()) - 0.48, p.z()) - 0.02); }
 
 struct Case {
   const char* name;
@@ -53,6 +54,7 @@ const std::vector<Case>& Cases() {
       {"sphere-disc", [](const Vec3& p) { return std::min(SphereD(p), DiscZ(p)); }},
       {"three-discs", [](const Vec3& p) { return std::min({DiscZ(p), DiscX(p), DiscY(p)}); }},
       {"torus", TorusD},
+      {"sphere-ring", [](const Vec3& p) { return std::min(std::abs(p.norm() - 0.35), RingD(p)); }},
   };
   return cases;
 }

@@ -6,9 +6,11 @@
 #include <unordered_map>
 
 #include "common/errors.h"
+#include "common/knn.h"
 #include "common/projection.h"
 #include "common/rng.h"
 #include "common/udf_spec.h"
+#include "stages/sample-seeds/thin_sizing.h"
 
 namespace voroudf {
 
@@ -20,6 +22,7 @@ void SampleSeedsOptions::Check() const {
   if (proj_max_iters < 1) throw UsageError("--proj-max-iters must be at least 1");
   if (!(band_rel >= 0.0)) throw UsageError("--band-rel must be >= 0");
   if (!(dedup_rel >= 0.0 && dedup_rel < 0.1)) throw UsageError("--dedup-rel must be in [0, 0.1)");
+  if (!(thin_boost >= 1.0 && thin_boost <= 64.0)) throw UsageError("--thin-boost must be in [1, 64]");
 }
 
 namespace {
@@ -102,13 +105,52 @@ std::vector<size_t> KeepDistinct(const std::vector<Vec3>& points, const std::vec
   return kept;
 }
 
+// Twice the median nearest-neighbour distance: about sqrt(area / count) for uniform points.
+double SpacingOf(const std::vector<Vec3>& p) {
+  int k_found = 0;
+  const std::vector<int> nearest = KNearestAmong(p, 1, &k_found, Monitor::Null(), "nearest seeds");
+  std::vector<double> nn;
+  for (size_t k = 0; k < p.size(); ++k)
+    if (nearest[k] >= 0) nn.push_back((p[static_cast<size_t>(nearest[k])] - p[k]).norm());
+  std::nth_element(nn.begin(), nn.begin() + static_cast<std::ptrdiff_t>(nn.size() / 2), nn.end());
+  return 2.0 * nn[nn.size() / 2];
+}
+
+// --thin-boost: `converged` holds a pool of ceil(boost) x count projected draws; chooses count of them with
+// probabilities growing with ThinSeedWeights (thin_sizing.h), in pool order.
+std::vector<size_t> ChooseForThinParts(const Udf& udf, const SampleSeedsOptions& options, const std::vector<size_t>& converged,
+                                       const std::vector<Vec3>& points, const std::vector<Vec3>& normal, Monitor& monitor) {
+  std::vector<Vec3> p(converged.size()), n(converged.size());
+  for (size_t k = 0; k < converged.size(); ++k) p[k] = points[converged[k]], n[k] = normal[converged[k]];
+  // The spacing of `count` uniform seeds, from the pool's.
+  const double h = SpacingOf(p) * std::sqrt(static_cast<double>(p.size()) / static_cast<double>(options.count));
+  const std::vector<double> thickness = ProbeThickness(udf, p, n, h);
+  const std::vector<double> weight = ThinSeedWeights(thickness, h, options.thin_boost);
+  const std::vector<size_t> chosen = ChooseWeighted(weight, options.count, options.seed);
+  std::vector<size_t> keep(chosen.size());
+  size_t thin = 0, thin_chosen = 0;
+  for (size_t k = 0; k < chosen.size(); ++k) keep[k] = converged[chosen[k]], thin_chosen += weight[chosen[k]] > 1.0;
+  for (double w : weight) thin += w > 1.0;
+  char line[300];
+  std::snprintf(line, sizeof line,
+                "thin parts: %zu of %zu pool points lie where the part is thinner than 2h (h = %.3g, the spacing of count uniform seeds); %zu of the %zu "
+                "seeds chosen there (uniform: %.0f)",
+                thin, p.size(), h, thin_chosen, chosen.size(),
+                static_cast<double>(thin) * static_cast<double>(chosen.size()) / static_cast<double>(p.size()));
+  monitor.Info(line);
+  return keep;
+}
+
 }  // namespace
 
 SeedCloud SampleSeeds(const Udf& udf, const SampleSeedsOptions& options, Monitor& monitor) {
   options.Check();
   const Box box = udf.Domain();
   monitor.Info("domain box " + FormatBox(box) + ", diagonal " + std::to_string(box.Diagonal()));
-  std::vector<Vec3> points = DrawInBand(udf, box, options, monitor);
+  SampleSeedsOptions draw_options = options;
+  if (options.thin_boost > 1.0)  // a pool to choose from (MoveSeedsToThinParts)
+    draw_options.count = static_cast<size_t>(std::ceil(options.thin_boost)) * options.count;
+  std::vector<Vec3> points = DrawInBand(udf, box, draw_options, monitor);
   ProjectionOptions proj;
   proj.tolerance = options.proj_tol_rel * box.Diagonal();
   proj.floor_tolerance = options.proj_floor_rel * box.Diagonal();
@@ -118,14 +160,18 @@ SeedCloud SampleSeeds(const Udf& udf, const SampleSeedsOptions& options, Monitor
   std::vector<size_t> converged;
   for (size_t i = 0; i < points.size(); ++i)
     if (r.converged[i]) converged.push_back(i);
+  std::vector<Vec3> normal = r.gradient;
+  std::vector<double> distance = r.distance;
+  if (options.thin_boost > 1.0 && converged.size() > 1)
+    converged = ChooseForThinParts(udf, options, converged, points, normal, monitor);
   const std::vector<size_t> kept = KeepDistinct(points, converged, options.dedup_rel * box.Diagonal());
 
   SeedCloud seeds;
   seeds.Resize(kept.size());
   for (size_t k = 0; k < kept.size(); ++k) {
     seeds.position[k] = points[kept[k]];
-    seeds.normal[k] = r.gradient[kept[k]];
-    seeds.udf[k] = r.distance[kept[k]];
+    seeds.normal[k] = normal[kept[k]];
+    seeds.udf[k] = distance[kept[k]];
   }
   const size_t dropped = points.size() - r.num_converged;
   char line[300];

@@ -26,6 +26,10 @@ struct SampleSeedsOptions {
   /// --proj-floor-rel: a seed at the bottom of a kink of d (common/projection.h) with d below this x diagonal
   /// has converged: learned and sampled fields have such a floor instead of zeros. 0: off.
   double proj_floor_rel = 1e-2;
+  /// --thin-boost B: draw ceil(B) x count points and choose count of them, up to B times likelier where the
+  /// part is thinner than 2 spacings (ThinSeedWeights in thin_sizing.h), so flat parts give seeds to thin ones;
+  /// 1: uniform, the paper.
+  double thin_boost = 1.0;
 
   /// Throws UsageError for values that cannot work.
   void Check() const;
