@@ -1,12 +1,14 @@
 // sample-seeds: the library on every built-in shape, and the real executable end to end.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "common/errors.h"
 #include "common/shapes.h"
 #include "formats/seeds_io.h"
 #include "stages/sample-seeds/sample_seeds.h"
+#include "stages/sample-seeds/thin_sizing.h"
 #include "tests/support/test_support.h"
 
 namespace voroudf {
@@ -97,12 +99,67 @@ TEST(SampleSeeds, DuplicatesAreDropped) {
       ASSERT_GE((seeds.position[i] - seeds.position[j]).norm(), radius);
 }
 
+bool OnRing(const Vec3& p) { return p.norm() > 0.42; }  // shape:sphere-ring: sphere radius 0.35, ring 0.45..0.51
+
+TEST(ThinParts, TheProbeFindsTheRingsThicknessAndNothingElse) {
+  const auto ring = MakeShape("sphere-ring");
+  SampleSeedsOptions options;
+  options.count = 2000;
+  const SeedCloud seeds = SampleSeeds(*ring, options, Monitor::Null());
+  // h = 0.05: the gap of 0.1 between sphere and ring is not passed (that needs s > 0.1 / 1.75).
+  const std::vector<double> t = ProbeThickness(*ring, seeds.position, seeds.normal, 0.05);
+  int ring_points = 0;
+  for (size_t i = 0; i < seeds.size(); ++i) {
+    if (OnRing(seeds.position[i])) {
+      ++ring_points;
+      EXPECT_GE(t[i], 0.06 / 1.75 * 1.25 - 1e-9) << seeds.position[i].transpose();  // tube diameter 0.06
+      EXPECT_LE(t[i], 0.06 * 1.25 * 2 / 1.75 + 1e-9) << seeds.position[i].transpose();
+    } else {
+      EXPECT_TRUE(std::isinf(t[i])) << seeds.position[i].transpose();  // 0.7 across
+    }
+  }
+  EXPECT_GT(ring_points, 100);
+  // A cube's faces meet its neighbours beside, not opposite: no concave or convex edge is a thin part.
+  const auto cube = MakeShape("cube");
+  const SeedCloud cube_seeds = SampleSeeds(*cube, options, Monitor::Null());
+  for (double thickness : ProbeThickness(*cube, cube_seeds.position, cube_seeds.normal, 0.4)) EXPECT_TRUE(std::isinf(thickness));
+}
+
+TEST(ThinParts, TheBoostMovesSeedsToTheRingAndKeepsTheCount) {
+  const auto ring = MakeShape("sphere-ring");
+  SampleSeedsOptions options;
+  options.count = 700;
+  auto ring_share = [&](const SeedCloud& s) {
+    size_t n = 0;
+    for (const Vec3& p : s.position) n += OnRing(p);
+    return static_cast<double>(n) / static_cast<double>(s.size());
+  };
+  const SeedCloud uniform = SampleSeeds(*ring, options, Monitor::Null());
+  options.thin_boost = 4;
+  const SeedCloud boosted = SampleSeeds(*ring, options, Monitor::Null());
+  EXPECT_EQ(boosted.size(), options.count);
+  EXPECT_NEAR(ring_share(uniform), 0.27, 0.05);  // the ring's share of the area
+  EXPECT_GT(ring_share(boosted), 1.5 * ring_share(uniform));
+  const SeedCloud again = SampleSeeds(*ring, options, Monitor::Null());
+  EXPECT_EQ(again.position, boosted.position);
+  // Weighted choice: heavier indices are chosen more often, and exactly `count` of them.
+  std::vector<double> w(1000, 1.0);
+  for (size_t i = 500; i < 1000; ++i) w[i] = 4.0;
+  const std::vector<size_t> chosen = ChooseWeighted(w, 200, 3);
+  ASSERT_EQ(chosen.size(), 200u);
+  EXPECT_TRUE(std::is_sorted(chosen.begin(), chosen.end()));
+  EXPECT_GT(std::count_if(chosen.begin(), chosen.end(), [](size_t i) { return i >= 500; }), 140);
+}
+
 TEST(SampleSeeds, BadOptionsAreUsageErrors) {
   SampleSeedsOptions options;
   options.count = 0;
   EXPECT_THROW(options.Check(), UsageError);
   options.count = 10;
   options.proj_tol_rel = 0;
+  EXPECT_THROW(options.Check(), UsageError);
+  options.proj_tol_rel = 1e-5;
+  options.thin_boost = 0.5;
   EXPECT_THROW(options.Check(), UsageError);
 }
 

@@ -35,7 +35,7 @@ double HemisphereD(const Vec3& p) {
   return std::hypot(std::hypot(p.x(), p.y()) - 0.5, p.z());  // below the cut: distance to the rim circle
 }
 double TorusD(const Vec3& p) { return std::abs(std::hypot(std::hypot(p.x(), p.y()) - 0.35, p.z()) - 0.15); }
-double RingD(const Vec3& p) { return std::abs(std::hypot(std::hypot(p.x(), p.y()) - 0.48, p.z()) - 0.02); }
+double RingD(const Vec3& p) { return std::abs(std::hypot(std::hypot(p.x(), p.y()) - 0.48, p.z()) - 0.03); }
 
 struct Case {
   const char* name;
