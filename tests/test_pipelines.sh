@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # End-to-end tests of the chained executables through the three drivers: pipelines/voroudf.sh,
-# Makefile.example and pipelines/Snakefile. Usage: test_pipelines.sh BIN_DIR {voroudf-sh|make|snakemake|benchmark}
+# Makefile.example and pipelines/Snakefile. Usage: test_pipelines.sh BIN_DIR {voroudf-sh|make|snakemake|benchmark|noise-study}
 set -euo pipefail
 BIN=$(cd "$1" && pwd)
 WHAT=$2
@@ -78,6 +78,21 @@ case "$WHAT" in
       sys.exit(0 if 0 < float(r['cd_exact_x1e3']) < float(r['cd_x1e3']) and float(r['cd_floor_x1e3']) > 0 else 1)" \
       "$TMP/bench/results.csv" || fail "exact CD not between 0 and the sampled CD, or no floor"
     grep -q '^cad,broken,.*exit 3' "$TMP/bench/results.csv" || { cat "$TMP/bench/results.csv"; fail "no error row"; }
+    ;;
+  noise-study)
+    # One ball at three noise levels and as a grid: a row each, none failed, and at a value error of 1e-3
+    # the mesh keeps its vertices (projection to a floor; without it about half the seeds were dropped).
+    bash "$ROOT/pipelines/voroudf.sh" --udf shape:sphere -o "$TMP/s" --count 300 2> /dev/null
+    mkdir -p "$TMP/data/cad"
+    cp "$TMP/s/mesh.ply" "$TMP/data/cad/ball.ply"
+    "$ROOT/pipelines/noise-study" --sets cad:1 --data "$TMP/data" --out "$TMP/study" --bin "$BIN" -j 2 --count 400 \
+      --levels clean,v1e-3,g15,grid --grid-resolution 32 > "$TMP/log" 2>&1 || { cat "$TMP/log"; fail "noise-study failed"; }
+    for level in clean v1e-3 g15 grid; do
+      grep -q "^| $level | 1 | 0 |" "$TMP/study/study.md" || { cat "$TMP/study/study.md"; fail "no row for $level"; }
+    done
+    /usr/bin/python3 -c "import csv,sys; r={r['level']: r for r in csv.DictReader(open(sys.argv[1]))}; \
+      sys.exit(0 if float(r['v1e-3']['vertices']) >= 0.9 * float(r['clean']['vertices']) else 1)" \
+      "$TMP/study/study.csv" || { cat "$TMP/study/study.md"; fail "the noisy run lost vertices"; }
     ;;
   *) fail "unknown test '$WHAT'" ;;
 esac
