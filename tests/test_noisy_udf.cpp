@@ -5,6 +5,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <memory>
+#include <string>
 
 #include "common/errors.h"
 #include "common/noisy_udf.h"
@@ -23,15 +25,25 @@ std::vector<Vec3> RandomPoints(size_t n, uint64_t seed) {
   return p;
 }
 
-TEST(NoisyUdf, ValueErrorHasTheAskedSpreadAndIsSmooth) {
-  const auto exact = OpenUdf("shape:sphere");
-  const auto noisy = OpenUdf("noisy:value=1e-3,scale=0.05:shape:sphere");
-  const double sigma = 1e-3 * exact->Domain().Diagonal();
-  const auto points = RandomPoints(20000, 3);
+// A SPEC and its noisy: wrapping evaluated at the same points.
+struct Pair {
+  std::unique_ptr<Udf> exact, noisy;
   std::vector<double> d0, d1;
   std::vector<Vec3> g0, g1;
-  exact->Evaluate(points, d0, g0);
-  noisy->Evaluate(points, d1, g1);
+  Pair(const std::string& spec, const std::string& noise, const std::vector<Vec3>& points)
+      : exact(OpenUdf(spec)), noisy(OpenUdf("noisy:" + noise + ":" + spec)) {
+    exact->Evaluate(points, d0, g0);
+    noisy->Evaluate(points, d1, g1);
+  }
+};
+
+TEST(NoisyUdf, ValueErrorHasTheAskedSpreadAndIsSmooth) {
+  const auto points = RandomPoints(20000, 3);
+  const Pair f("shape:sphere", "value=1e-3,scale=0.05", points);
+  const auto &exact = f.exact, &noisy = f.noisy;
+  const auto &d0 = f.d0, &d1 = f.d1;
+  const auto &g0 = f.g0, &g1 = f.g1;
+  const double sigma = 1e-3 * exact->Domain().Diagonal();
   double sum = 0, sum2 = 0;
   int n = 0;
   for (size_t i = 0; i < points.size(); ++i) {
@@ -63,13 +75,10 @@ TEST(NoisyUdf, ValueErrorHasTheAskedSpreadAndIsSmooth) {
 }
 
 TEST(NoisyUdf, GradientIsTurnedByExactlyTheAskedAngle) {
-  const auto exact = OpenUdf("shape:cube");
-  const auto noisy = OpenUdf("noisy:grad=15:shape:cube");
   const auto points = RandomPoints(5000, 4);
-  std::vector<double> d0, d1;
-  std::vector<Vec3> g0, g1;
-  exact->Evaluate(points, d0, g0);
-  noisy->Evaluate(points, d1, g1);
+  const Pair f("shape:cube", "grad=15", points);
+  const auto &d0 = f.d0, &d1 = f.d1;
+  const auto &g0 = f.g0, &g1 = f.g1;
   double turned_min = 180, turned_max = 0;
   Vec3 mean_turn = Vec3::Zero();
   for (size_t i = 0; i < points.size(); ++i) {
@@ -106,17 +115,11 @@ TEST(NoisyUdf, AFunctionOfThePointAndTheSeedOnly) {
 }
 
 TEST(NoisyUdf, NoNoiseIsTheInnerField) {
-  const auto exact = OpenUdf("shape:torus");
-  const auto noisy = OpenUdf("noisy:value=0,grad=0:shape:torus");
-  const auto points = RandomPoints(3000, 6);
-  std::vector<double> d0, d1;
-  std::vector<Vec3> g0, g1;
-  exact->Evaluate(points, d0, g0);
-  noisy->Evaluate(points, d1, g1);
-  EXPECT_EQ(d0, d1);
-  EXPECT_EQ(g0, g1);
-  EXPECT_EQ(noisy->Domain().min, exact->Domain().min);
-  EXPECT_NE(noisy->Describe().find("noisy"), std::string::npos);
+  const Pair f("shape:torus", "value=0,grad=0", RandomPoints(3000, 6));
+  EXPECT_EQ(f.d0, f.d1);
+  EXPECT_EQ(f.g0, f.g1);
+  EXPECT_EQ(f.noisy->Domain().min, f.exact->Domain().min);
+  EXPECT_NE(f.noisy->Describe().find("noisy"), std::string::npos);
   EXPECT_EQ(BaseUdfSpec("noisy:value=1e-3:noisy:grad=5:grid.npy"), "grid.npy");
 }
 
