@@ -28,6 +28,15 @@ if ((${#missing[@]})); then
   $SUDO env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends "${missing[@]}" >&2
 fi
 
+# `import voroudf` from Debian's python3 without PYTHONPATH (README, docs/python.md): a path file in the user's
+# site-packages that points at python/, as `pip install -e` would write (PEP 668 keeps pip off Debian's own
+# python). Said when written; delete the file to undo.
+site=$(/usr/bin/python3 -m site --user-site 2> /dev/null || true)
+if [ -n "$site" ] && mkdir -p "$site" 2> /dev/null && [ "$(cat "$site/voroudf.pth" 2> /dev/null)" != "$ROOT/python" ]; then
+  echo "$ROOT/python" > "$site/voroudf.pth" &&
+    echo "voroudf setup: python3 can 'import voroudf' from this clone ($site/voroudf.pth)" >&2
+fi
+
 # shellcheck disable=SC2086  # VOROUDF_CMAKE_ARGS is a list of arguments
 cmake -S "$ROOT" -B "$ROOT/build" -DCMAKE_BUILD_TYPE=Release ${VOROUDF_CMAKE_ARGS:-} >&2
 cmake --build "$ROOT/build" -j"$(nproc)" >&2
