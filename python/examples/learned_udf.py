@@ -57,9 +57,9 @@ def main():
     p.add_argument("--seeds", type=int, default=2500)
     p.add_argument("--steps", type=int, default=1500)
     p.add_argument("--workdir", default="learned-udf")
-    p.add_argument("--proj-tol-rel", type=float, default=3e-3,
-                   help="projection tolerance of the stages: a learned UDF has no exact zero set, its minimum is "
-                        "about its fitting error (the programs' default, 1e-5, is for exact UDFs)")
+    p.add_argument("--proj-tol-rel", type=float, default=None,
+                   help="projection tolerance of the stages (default: the programs', which accept a learned "
+                        "field's floor, --proj-floor-rel)")
     a = p.parse_args()
     torch.manual_seed(0)
     torch.set_num_threads(os.cpu_count() or 1)
@@ -104,9 +104,9 @@ def main():
         return torch.cat(out_d), torch.cat(out_g)
 
     t0 = time.time()
-    tol = f"--proj-tol-rel {a.proj_tol_rel}"
+    tol = f"--proj-tol-rel {a.proj_tol_rel}" if a.proj_tol_rel else None
     m = voroudf.mesh(udf, box=([-0.6] * 3, [0.6] * 3), seeds=a.seeds, workdir=a.workdir, sample_seeds=tol,
-                     optimize_seeds=tol, build_gvd=f"{tol} --eps-udf-rel {max(2e-3, 2 * a.proj_tol_rel)}")
+                     optimize_seeds=tol, build_gvd=tol)
     mesh_s = time.time() - t0
     # The reference in the same frame: the programs normalise the mesh the same way with --udf-normalize.
     ref = os.path.join(a.workdir, "reference.ply")
