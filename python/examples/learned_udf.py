@@ -57,9 +57,10 @@ def main():
     p.add_argument("--seeds", type=int, default=2500)
     p.add_argument("--steps", type=int, default=1500)
     p.add_argument("--workdir", default="learned-udf")
-    p.add_argument("--proj-tol-rel", type=float, default=None,
-                   help="projection tolerance of the stages (default: the programs', which accept a learned "
-                        "field's floor, --proj-floor-rel)")
+    p.add_argument("--proj-tol-rel", type=float, default=3e-3,
+                   help="projection tolerance of the stages; 0: the programs' own (1e-5, with a learned field's "
+                        "floor accepted at a kink's bottom), which lets seeds follow the network's gradient lines "
+                        "onto its rounded creases (docs/python.md)")
     a = p.parse_args()
     torch.manual_seed(0)
     torch.set_num_threads(os.cpu_count() or 1)
