@@ -12,6 +12,7 @@
 #include "common/atomic_file.h"
 #include "common/cleanup.h"
 #include "common/errors.h"
+#include "common/shapes.h"
 
 namespace voroudf {
 namespace {
@@ -101,10 +102,12 @@ void StageCli::MarkNonSemantic(const std::string& flag) { non_semantic_.insert(f
 
 CLI::Option* StageCli::AddUdf(std::string* spec) {
   udf_spec_ = spec;
+  std::string names;
+  for (const auto& [name, description] : ShapeCatalog()) names += (names.empty() ? "" : " ") + name;
   CLI::Option* opt = app_.add_option(
       "--udf", *spec,
-      "UDF source: shape:NAME (sphere cube disc hemisphere crossing-planes sphere-disc three-discs torus), "
-      "a mesh .obj/.off/.ply/.stl, a grid .npy, exec:COMMAND, or unix:SOCKET (a running server)");
+      "UDF source: shape:NAME (" + names + "), a mesh .obj/.off/.ply/.stl, a grid .npy, exec:COMMAND, "
+      "unix:SOCKET (a running server), or noisy:value=S,grad=A:SPEC (SPEC with errors, docs/udf-sources.md)");
   opt->required();
   app_.add_option("--udf-box", udf_options_.grid_box, "domain box of a .npy grid: xmin,ymin,zmin,xmax,ymax,zmax");
   app_.add_option("--udf-timeout", udf_options_.exec_timeout_s,

@@ -248,8 +248,10 @@ TEST_F(SampleSeedsExe, FailuresExitWithTheDocumentedCodeAndLeaveNoFile) {
 TEST_F(SampleSeedsExe, HelpExplainsTheOptions) {
   const auto r = RunProgram("sample-seeds", {"--help"});
   EXPECT_EQ(r.exit_code, 0);
-  for (const char* flag : {"--udf", "--count", "--seed", "--threads", "--output", "--proj-tol-rel", "--ascii", "--quiet"})
+  for (const char* flag : {"--udf", "--count", "--seed", "--threads", "--output", "--proj-tol-rel", "--ascii", "--quiet",
+                           "--thin-boost", "--proj-floor-rel", "noisy:"})
     EXPECT_NE(r.out.find(flag), std::string::npos) << flag;
+  for (const auto& [name, description] : ShapeCatalog()) EXPECT_NE(r.out.find(name), std::string::npos) << name;
 }
 
 }  // namespace
