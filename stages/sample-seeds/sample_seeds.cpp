@@ -133,8 +133,8 @@ std::vector<size_t> ChooseForThinParts(const Udf& udf, const SampleSeedsOptions&
   for (double w : weight) thin += w > 1.0;
   char line[300];
   std::snprintf(line, sizeof line,
-                "thin parts: %zu of %zu pool points lie where the part is thinner than 2h (h = %.3g, the spacing of count uniform seeds); %zu of the %zu "
-                "seeds chosen there (uniform: %.0f)",
+                "thin parts: %zu of %zu pool points lie where the part is thinner than 2h (h = %.3g, the spacing of "
+                "count uniform seeds); %zu of the %zu seeds chosen there (uniform: %.0f)",
                 thin, p.size(), h, thin_chosen, chosen.size(),
                 static_cast<double>(thin) * static_cast<double>(chosen.size()) / static_cast<double>(p.size()));
   monitor.Info(line);
@@ -148,7 +148,7 @@ SeedCloud SampleSeeds(const Udf& udf, const SampleSeedsOptions& options, Monitor
   const Box box = udf.Domain();
   monitor.Info("domain box " + FormatBox(box) + ", diagonal " + std::to_string(box.Diagonal()));
   SampleSeedsOptions draw_options = options;
-  if (options.thin_boost > 1.0)  // a pool to choose from (MoveSeedsToThinParts)
+  if (options.thin_boost > 1.0)  // a pool to choose from (ChooseForThinParts)
     draw_options.count = static_cast<size_t>(std::ceil(options.thin_boost)) * options.count;
   std::vector<Vec3> points = DrawInBand(udf, box, draw_options, monitor);
   ProjectionOptions proj;
@@ -160,18 +160,16 @@ SeedCloud SampleSeeds(const Udf& udf, const SampleSeedsOptions& options, Monitor
   std::vector<size_t> converged;
   for (size_t i = 0; i < points.size(); ++i)
     if (r.converged[i]) converged.push_back(i);
-  std::vector<Vec3> normal = r.gradient;
-  std::vector<double> distance = r.distance;
   if (options.thin_boost > 1.0 && converged.size() > 1)
-    converged = ChooseForThinParts(udf, options, converged, points, normal, monitor);
+    converged = ChooseForThinParts(udf, options, converged, points, r.gradient, monitor);
   const std::vector<size_t> kept = KeepDistinct(points, converged, options.dedup_rel * box.Diagonal());
 
   SeedCloud seeds;
   seeds.Resize(kept.size());
   for (size_t k = 0; k < kept.size(); ++k) {
     seeds.position[k] = points[kept[k]];
-    seeds.normal[k] = normal[kept[k]];
-    seeds.udf[k] = distance[kept[k]];
+    seeds.normal[k] = r.gradient[kept[k]];
+    seeds.udf[k] = r.distance[kept[k]];
   }
   const size_t dropped = points.size() - r.num_converged;
   char line[300];

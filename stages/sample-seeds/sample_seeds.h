@@ -39,7 +39,8 @@ struct SampleSeedsOptions {
 /// result does not depend on the thread count) and keeps the first `count` with d < band_rel * diagonal
 /// (all of them if band_rel = 0); projects each with x <- x - d(x) n(x) until d < proj_tol_rel * diagonal;
 /// keeps the converged ones in draw order, without those within dedup_rel * diagonal of an earlier seed,
-/// with their UDF value and gradient (rank 0: unknown until optimize-seeds).
+/// with their UDF value and gradient (rank 0: unknown until optimize-seeds). With thin_boost > 1 the draw is
+/// ceil(thin_boost) x count and `count` of the converged ones are chosen, likelier where the part is thin.
 /// Throws NumericalError if no candidate falls in the band or none converged.
 SeedCloud SampleSeeds(const Udf& udf, const SampleSeedsOptions& options, Monitor& monitor);
 
