@@ -230,6 +230,10 @@ TEST_F(SampleSeedsExe, FailuresExitWithTheDocumentedCodeAndLeaveNoFile) {
       {{"--udf", "shape:sphere", "--count", "10"}, kExitUsage, "--output is required"},
       {{"--udf", "shape:pyramid", "--count", "10", "-o", out}, kExitBadInput, "unknown built-in shape"},
       {{"--udf", "field.xyz", "--count", "10", "-o", out}, kExitBadInput, "expected shape:NAME"},
+      {{"--udf", "noisy:value=-1:shape:cube", "--count", "10", "-o", out}, kExitUsage, "value= must be in [0, 1]"},
+      {{"--udf", "noisy:grad=15", "--count", "10", "-o", out}, kExitUsage, "expected noisy:OPTIONS:SPEC"},
+      {{"--udf", "noisy:grad=15:shape:pyramid", "--count", "10", "-o", out}, kExitBadInput, "unknown built-in shape"},
+      {{"--udf", "shape:sphere", "--count", "10", "--thin-boost", "0.5", "-o", out}, kExitUsage, "--thin-boost"},
       {{"--udf", "shape:sphere", "--count", "10", "-o", dir_ / "no/such/dir/s.ply"}, kExitFailure, "does not exist"},
       {{"--udf", "shape:sphere", "--count", "10", "-o", dir_.path()}, kExitFailure, "is a directory"},
   };
