@@ -2,7 +2,23 @@
 
 #include <cmath>
 
+#include "common/errors.h"
+
 namespace voroudf {
+
+ProjectionOptions RelativeProjection(double diagonal, double tol_rel, double floor_rel, int max_iterations) {
+  ProjectionOptions options;
+  options.tolerance = tol_rel * diagonal;
+  options.floor_tolerance = floor_rel * diagonal;
+  options.max_iterations = max_iterations;
+  return options;
+}
+
+void CheckRelativeProjection(double tol_rel, double floor_rel, int max_iterations) {
+  if (!(tol_rel > 0.0 && tol_rel < 0.1)) throw UsageError("--proj-tol-rel must be in (0, 0.1)");
+  if (!(floor_rel >= 0.0 && floor_rel < 0.1)) throw UsageError("--proj-floor-rel must be in [0, 0.1)");
+  if (max_iterations < 1) throw UsageError("--proj-max-iters must be at least 1");
+}
 
 ProjectionResult ProjectToZeroSet(const Udf& udf, std::vector<Vec3>& points, const ProjectionOptions& options,
                                   Monitor& monitor) {

@@ -23,6 +23,18 @@ struct ProjectionResult {
   size_t num_at_floor = 0;        ///< of those, converged at a kink's bottom above `tolerance`
 };
 
+/// The stages' --proj-tol-rel, --proj-floor-rel and --proj-max-iters (relative to the domain diagonal) as
+/// the absolute options for a domain of diagonal `diagonal`.
+ProjectionOptions RelativeProjection(double diagonal, double tol_rel, double floor_rel, int max_iterations);
+
+/// Throws UsageError naming the option unless tol_rel is in (0, 0.1), floor_rel in [0, 0.1) and
+/// max_iterations at least 1.
+void CheckRelativeProjection(double tol_rel, double floor_rel, int max_iterations);
+
+/// --proj-floor-rel's help line, the same in every stage.
+inline constexpr const char* kProjFloorRelHelp =
+    "a kink's bottom with d below this x diagonal counts as on the zero set (learned/sampled fields' floor; 0: off)";
+
 /// Moves every point by x <- x - d(x) n(x) until d(x) < tolerance (DESIGN.md, stage 1). An exact UDF needs
 /// one step; sampled or learned fields need a few.
 ///

@@ -62,6 +62,16 @@ class NormalizedUdf : public Udf {
   Box domain_;
 };
 
+// "noisy:OPTIONS:INNER" -> {OPTIONS, INNER}: the options end at the first ':' after the prefix, the rest is
+// the inner SPEC (which may itself contain ':'). False if there is no such ':'.
+bool SplitNoisySpec(const std::string& spec, std::string* options, std::string* inner) {
+  const auto colon = spec.find(':', 6);
+  if (!StartsWith(spec, "noisy:") || colon == std::string::npos) return false;
+  *options = spec.substr(6, colon - 6);
+  *inner = spec.substr(colon + 1);
+  return true;
+}
+
 }  // namespace
 
 std::string FormatBox(const Box& box) {
@@ -76,8 +86,8 @@ std::unique_ptr<Udf> NormalizeUdf(std::unique_ptr<Udf> inner, const Box& frame) 
 }
 
 std::string BaseUdfSpec(const std::string& spec) {
-  std::string base = spec;
-  while (StartsWith(base, "noisy:") && base.find(':', 6) != std::string::npos) base = base.substr(base.find(':', 6) + 1);
+  std::string base = spec, options, inner;
+  while (SplitNoisySpec(base, &options, &inner)) base = inner;
   return base;
 }
 
@@ -117,12 +127,11 @@ std::unique_ptr<Udf> OpenUdf(const std::string& spec, const UdfSourceOptions& op
     case UdfSourceKind::kUnix:
       return by_domain(std::make_unique<ExecUdf>(ExecUdf::UnixSocket{spec.substr(5)}, exec_options));
     case UdfSourceKind::kNoisy: {
-      // The options end at the first ':'; the rest is the inner SPEC (which may itself contain ':').
-      const auto colon = spec.find(':', 6);
-      if (colon == std::string::npos)
+      std::string noise_options, inner;
+      if (!SplitNoisySpec(spec, &noise_options, &inner))
         throw UsageError("--udf '" + spec + "': expected noisy:OPTIONS:SPEC, e.g. noisy:value=1e-3,grad=15:shape:cube");
-      const UdfNoise noise = ParseUdfNoise(spec.substr(6, colon - 6));
-      return MakeNoisyUdf(OpenUdf(spec.substr(colon + 1), options), noise);
+      const UdfNoise noise = ParseUdfNoise(noise_options);
+      return MakeNoisyUdf(OpenUdf(inner, options), noise);
     }
   }
   throw InputError(spec, "unknown kind of UDF source");

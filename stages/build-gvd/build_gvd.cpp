@@ -76,9 +76,7 @@ void BuildGvdOptions::Check() const {
   if (knn < 3 || knn > 200) throw UsageError("--knn must be in [3, 200]");
   if (!(eps_udf_rel > 0.0 && eps_udf_rel < 1.0)) throw UsageError("--eps-udf-rel must be in (0, 1)");
   if (!(eps_grad > 0.0 && eps_grad <= 1.0)) throw UsageError("--eps-grad must be in (0, 1]");
-  if (!(proj_tol_rel > 0.0 && proj_tol_rel < 0.1)) throw UsageError("--proj-tol-rel must be in (0, 0.1)");
-  if (!(proj_floor_rel >= 0.0 && proj_floor_rel < 0.1)) throw UsageError("--proj-floor-rel must be in [0, 0.1)");
-  if (proj_max_iters < 1) throw UsageError("--proj-max-iters must be at least 1");
+  CheckRelativeProjection(proj_tol_rel, proj_floor_rel, proj_max_iters);
 }
 
 namespace {
@@ -390,10 +388,7 @@ GvdResult BuildGvd(const Udf& udf, const SeedCloud& seeds, const BuildGvdOptions
   std::vector<Vec3> samples = DrawSamples(seeds, box, options, &in_space);
   const size_t total = samples.size();
   stats.samples_drawn = total;
-  ProjectionOptions proj;
-  proj.tolerance = options.proj_tol_rel * diag;
-  proj.floor_tolerance = options.proj_floor_rel * diag;
-  proj.max_iterations = options.proj_max_iters;
+  const ProjectionOptions proj = RelativeProjection(diag, options.proj_tol_rel, options.proj_floor_rel, options.proj_max_iters);
   const ProjectionResult projected = ProjectToZeroSet(udf, samples, proj, monitor);
   stats.samples_projected = projected.num_converged;
 

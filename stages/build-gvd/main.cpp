@@ -1,6 +1,7 @@
 // build-gvd: the dual of the approximate geodesic Voronoi diagram of the seeds (docs/build-gvd.md).
 #include "common/cli.h"
 #include "common/errors.h"
+#include "common/projection.h"
 #include "formats/mesh_io.h"
 #include "stages/build-gvd/build_gvd.h"
 
@@ -36,7 +37,7 @@ int main(int argc, char** argv) {
                  "with --dual delaunay: seeds whose normals agree within this angle (deg) share a chart");
   app.add_option("--proj-tol-rel", options.proj_tol_rel, "projection tolerance on d, relative to the diagonal");
   app.add_option("--proj-max-iters", options.proj_max_iters, "projection steps before a sample is dropped");
-  app.add_option("--proj-floor-rel", options.proj_floor_rel, "a kink's bottom with d below this x diagonal counts as on the zero set (learned/sampled fields' floor; 0: off)");
+  app.add_option("--proj-floor-rel", options.proj_floor_rel, voroudf::kProjFloorRelHelp);
 
   return cli.Run(argc, argv, [&] { options.Check(); }, [&](voroudf::Monitor& monitor) {
     const auto udf = cli.OpenUdf(monitor);

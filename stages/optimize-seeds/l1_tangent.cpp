@@ -4,7 +4,6 @@
 #include <algorithm>
 #include <cmath>
 
-
 namespace voroudf {
 
 void L1TangentProblem::AddTerm(const Vec3& a_m, double b_m, double tolerance) {

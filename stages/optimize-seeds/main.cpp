@@ -4,6 +4,7 @@
 
 #include "common/cli.h"
 #include "common/errors.h"
+#include "common/projection.h"
 #include "stages/optimize-seeds/optimize_seeds.h"
 
 int main(int argc, char** argv) {
@@ -46,7 +47,7 @@ int main(int argc, char** argv) {
   app.add_option("--outer-tol", o.outer_tol, "outer loop ends when the spacing CV improves by less than this, relatively");
   app.add_option("--proj-tol-rel", o.proj_tol_rel, "projection tolerance on d, relative to the diagonal");
   app.add_option("--proj-max-iters", o.proj_max_iters, "projection steps before a move is undone");
-  app.add_option("--proj-floor-rel", o.proj_floor_rel, "a kink's bottom with d below this x diagonal counts as on the zero set (learned/sampled fields' floor; 0: off)");
+  app.add_option("--proj-floor-rel", o.proj_floor_rel, voroudf::kProjFloorRelHelp);
 
   return cli.Run(argc, argv, [&] { o.Check(); }, [&](voroudf::Monitor& monitor) {
     const auto udf = cli.OpenUdf(monitor);

@@ -40,9 +40,7 @@ void OptimizeSeedsOptions::Check() const {
   if (l1_max_steps < 1) throw UsageError("--l1-max-steps must be at least 1");
   if (!(move_tol >= 0.0 && move_tol < 1.0)) throw UsageError("--move-tol must be in [0, 1)");
   if (!(outer_tol >= 0.0 && outer_tol < 1.0)) throw UsageError("--outer-tol must be in [0, 1)");
-  if (!(proj_tol_rel > 0.0 && proj_tol_rel < 0.1)) throw UsageError("--proj-tol-rel must be in (0, 0.1)");
-  if (!(proj_floor_rel >= 0.0 && proj_floor_rel < 0.1)) throw UsageError("--proj-floor-rel must be in [0, 0.1)");
-  if (proj_max_iters < 1) throw UsageError("--proj-max-iters must be at least 1");
+  CheckRelativeProjection(proj_tol_rel, proj_floor_rel, proj_max_iters);
 }
 
 namespace {
@@ -136,9 +134,7 @@ class Optimizer {
     cell_options_.radius_factor = options.cell_radius_factor;
     cell_options_.early_samples = options.early_samples;
     cell_options_.early_rank_threshold = 0.5 * options.rank_threshold;
-    projection_.tolerance = options.proj_tol_rel * diagonal_;
-    projection_.floor_tolerance = options.proj_floor_rel * diagonal_;
-    projection_.max_iterations = options.proj_max_iters;
+    projection_ = RelativeProjection(diagonal_, options.proj_tol_rel, options.proj_floor_rel, options.proj_max_iters);
   }
 
   // Projects `moved` onto the zero set; a seed whose projection fails goes back to `previous` (which is on
@@ -547,6 +543,7 @@ class Optimizer {
   size_t last_short_cells() const { return last_short_cells_; }
   double last_acceptance() const { return last_acceptance_; }
   double normal_spread() const { return normal_spread_; }
+  const ProjectionOptions& projection() const { return projection_; }
 
  private:
   const Udf& udf_;
@@ -696,11 +693,7 @@ SeedCloud OptimizeSeeds(const Udf& udf, const SeedCloud& input, const OptimizeSe
   using Clock = std::chrono::steady_clock;
   const auto start = Clock::now();
   Optimizer opt(udf, options, monitor);
-  ProjectionOptions projection;
-  projection.tolerance = options.proj_tol_rel * opt.diagonal();
-  projection.floor_tolerance = options.proj_floor_rel * opt.diagonal();
-  projection.max_iterations = options.proj_max_iters;
-  State s = Prepare(udf, input, projection, monitor);
+  State s = Prepare(udf, input, opt.projection(), monitor);
   const size_t n = s.position.size();
   const double cv_in = opt.SpacingStats(s.position).second;
   monitor.Info(std::to_string(n) + " seeds on the surface; domain diagonal " + Format("%.6g", opt.diagonal()) +

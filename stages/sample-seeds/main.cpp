@@ -1,5 +1,6 @@
 // sample-seeds: N seeds uniform in the UDF's domain box, projected onto its zero set (docs/sample-seeds.md).
 #include "common/cli.h"
+#include "common/projection.h"
 #include "stages/sample-seeds/sample_seeds.h"
 
 int main(int argc, char** argv) {
@@ -23,7 +24,7 @@ int main(int argc, char** argv) {
                  "projection tolerance on d, relative to the domain box diagonal");
   app.add_option("--proj-max-iters", options.proj_max_iters, "projection steps before a seed is dropped");
   app.add_option("--thin-boost", options.thin_boost, "up to this many times the seeds where the part is thinner than two spacings (1: uniform)");
-  app.add_option("--proj-floor-rel", options.proj_floor_rel, "a kink's bottom with d below this x diagonal counts as on the zero set (learned/sampled fields' floor; 0: off)");
+  app.add_option("--proj-floor-rel", options.proj_floor_rel, voroudf::kProjFloorRelHelp);
 
   return cli.Run(argc, argv, [&] { options.Check(); }, [&](voroudf::Monitor& monitor) {
     const auto udf = cli.OpenUdf(monitor);
