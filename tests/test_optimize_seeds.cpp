@@ -778,7 +778,7 @@ TEST_F(OptimizeSeedsExe, WritesSeedsOnTheSurfaceWithRanksAndATrace) {
   EXPECT_NE(r.err.find("outer 1:"), std::string::npos) << r.err;
   const SeedCloud seeds = ReadSeeds(out);
   // A few seeds crowding the curves and the point where the three curves meet are dropped, and said so.
-  EXPECT_GE(seeds.size(), 270u);  // 283 measured
+  EXPECT_GE(seeds.size(), 265u);  // 268-279 measured over --seed 2-5 of sample-seeds, both --cell-samples
   EXPECT_LE(seeds.size(), 300u);
   if (seeds.size() < 300u) {
     EXPECT_NE(r.err.find(std::to_string(300 - seeds.size()) + " seeds dropped"), std::string::npos) << r.err;

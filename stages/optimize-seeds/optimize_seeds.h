@@ -3,6 +3,7 @@
 // features with the constrained L1 tangent step, and spreads them evenly with feature-aware repulsion.
 #include <cstdint>
 #include <functional>
+#include <string>
 
 #include "common/monitor.h"
 #include "common/udf.h"
@@ -17,6 +18,11 @@ struct OptimizeSeedsOptions {
   /// show one tangent plane clearly (rank 1 at half the rank threshold) keeps only those; 0: every cell
   /// gets M (--early-samples). Not in the paper, see docs/optimize-seeds.md ("Early samples").
   int early_samples = 0;
+  /// --cell-samples: "fresh" (default), M new rejection draws per cell and round (the paper); "pool", each
+  /// cell's M samples are its M lowest-mark points of one random point set fixed for the run
+  /// (sample_pool.h), so that a cell that moved little keeps most samples and their UDF values: about a
+  /// twelfth of the queries, for slightly worse topology beside branching curves (docs/optimize-seeds.md).
+  std::string cell_samples = "fresh";
   double gamma = 10.0;            ///< γ, proximity weight, lengths relative to the domain diagonal (paper: 10) (--gamma)
   double delta = 1e-3;            ///< δ, inner loop stops when the gradient changes by less than this, relatively (paper: 1e-3) (--delta)
   int max_outer_iters = 3;        ///< cap on Alg. 1's outer loop (--max-outer-iters; see docs for why 3)

@@ -60,6 +60,8 @@ CellSamples SampleVoronoiCells(const Udf& udf, const std::vector<Vec3>& seeds, c
     }
   }
 
+  // With a pool, the cells' shapes are collected here and their samples chosen from it afterwards.
+  std::vector<SamplePool::Cell> shapes(options.pool ? n : 0);
 #pragma omp parallel
   {
     std::vector<int> knn, found;
@@ -93,6 +95,10 @@ CellSamples SampleVoronoiCells(const Udf& udf, const std::vector<Vec3>& seeds, c
         half_sq.push_back(0.5 * e.squaredNorm());
       }
       if (r <= 0.0) continue;
+      if (options.pool) {
+        shapes[i] = {xi, r, offsets, half_sq};
+        continue;
+      }
       Rng rng(rng_seed, round * n + i);
       const uint64_t budget = m_max * static_cast<uint64_t>(options.max_draws_per_sample);
       size_t count = 0;
@@ -113,6 +119,21 @@ CellSamples SampleVoronoiCells(const Udf& udf, const std::vector<Vec3>& seeds, c
     }
   }
 
+  std::vector<std::vector<SamplePool::PointId>> chosen;
+  if (options.pool) {
+    std::vector<uint64_t> examined;
+    if (incremental && previous->pool_mark.size() == n) cells.pool_mark = previous->pool_mark;
+    chosen = options.pool->Select(shapes, redo, m_max, static_cast<double>(m_max) * options.max_draws_per_sample,
+                                  cells.pool_mark, &examined);
+    for (size_t i = 0; i < n; ++i) {
+      if (!redo[i]) continue;
+      accepted[i] = chosen[i].size();
+      draws[i] = std::max<uint64_t>(examined[i], accepted[i]);
+      short_draw[i] = accepted[i] < m_max;
+      for (size_t k = 0; k < accepted[i]; ++k) candidates[i * m_max + k] = options.pool->Point(chosen[i][k]);
+    }
+  }
+
   // The UDF at the redrawn cells' candidates, in up to two batches: first the first `early_samples` of
   // each cell; a cell whose first samples already show one tangent plane clearly (rank 1 at the stricter
   // threshold early_rank_threshold) keeps just those, the others get the rest in the second batch.
@@ -127,6 +148,16 @@ CellSamples SampleVoronoiCells(const Udf& udf, const std::vector<Vec3>& seeds, c
     for (size_t i = 0; i < n; ++i)
       if (redo[i] && wanted(i))
         for (size_t k = from; k < std::min(accepted[i], from == 0 ? early : m_max); ++k) at.push_back(i * m_max + k);
+    if (options.pool) {
+      std::vector<SamplePool::PointId> ids(at.size());
+      for (size_t k = 0; k < at.size(); ++k) ids[k] = chosen[at[k] / m_max][at[k] % m_max];
+      cells.reused += at.size() - options.pool->Evaluate(udf, ids);
+      for (size_t k = 0; k < at.size(); ++k) {
+        cand_d[at[k]] = options.pool->Distance(ids[k]);
+        cand_g[at[k]] = options.pool->Gradient(ids[k]);
+      }
+      return;
+    }
     std::vector<Vec3> points(at.size());
     for (size_t k = 0; k < at.size(); ++k) points[k] = candidates[at[k]];
     std::vector<double> d;

@@ -7,6 +7,7 @@
 
 #include "common/monitor.h"
 #include "common/udf.h"
+#include "stages/optimize-seeds/sample_pool.h"
 #include "stages/optimize-seeds/seed_index.h"
 
 namespace voroudf {
@@ -23,6 +24,9 @@ struct CellSamplingOptions {
   double early_rank_threshold = 0.2;
   /// Optional, per seed: only cells marked here may stop at their early samples (null: every cell).
   const std::vector<char>* early_allowed = nullptr;
+  /// Optional: take each cell's samples from this pool (its M lowest-mark points in the cell, whose UDF
+  /// values the pool keeps across calls) instead of fresh rejection draws from (rng_seed, round).
+  SamplePool* pool = nullptr;
 };
 
 /// Per seed i: the bounding radius R_i, the seeds within 2 R_i (the only ones whose bisector planes can cut
@@ -41,13 +45,17 @@ struct CellSamples {
   size_t short_cells = 0;                ///< redrawn cells that got fewer than M samples within the budget
   size_t redrawn = 0;                    ///< cells sampled in this call (the others were kept)
   size_t early_cells = 0;                ///< of which kept their early samples only (early_samples)
+  size_t reused = 0;                     ///< samples of redrawn cells whose UDF value the pool already had
+  std::vector<double> pool_mark;         ///< with a pool: per cell, the mark of its M-th sample (0: fewer)
   std::vector<char> early_kept;          ///< per cell: 1 if it has its early samples only
 };
 
 /// Draws up to M points uniformly in Ω_i ∩ B(x_i, R_i) for every seed by rejection from the ball's bounding cube (exact
 /// nearest-seed test against the seeds within 2 R_i, found with PCL's kd-tree), then evaluates the UDF at
 /// all of them in one batch. Seed i draws from the counter-based stream (rng_seed, round · N + i), so the
-/// result does not depend on the thread count. \pre seeds.size() ≥ 2, index built over `seeds`.
+/// result does not depend on the thread count. With options.pool the M points are the cell's M lowest-mark
+/// points of the pool instead (also uniform in the cell, sample_pool.h), and the UDF is asked only at
+/// those it has not seen. \pre seeds.size() ≥ 2, index built over `seeds`.
 ///
 /// Incremental use: given the previous call's result and seed positions, a cell is kept as it was (same
 /// radius, neighbours, samples and UDF values) when no seed within its influence radius (2R_i, and the

@@ -1,0 +1,200 @@
+#include "stages/optimize-seeds/sample_pool.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <utility>
+
+namespace voroudf {
+namespace {
+
+constexpr int64_t kAxisBits = 21;
+constexpr int64_t kAxisOffset = int64_t{1} << (kAxisBits - 1);
+
+int64_t GridKey(int64_t x, int64_t y, int64_t z) {
+  const int64_t mask = (int64_t{1} << kAxisBits) - 1;
+  return (((x + kAxisOffset) & mask) << (2 * kAxisBits)) | (((y + kAxisOffset) & mask) << kAxisBits) |
+         ((z + kAxisOffset) & mask);
+}
+
+// Squared distance from c to the cube [lo, lo + size]³.
+double BoxGapSquared(const Vec3& c, const Vec3& lo, double size) {
+  double gap_sq = 0.0;
+  for (int a = 0; a < 3; ++a) {
+    const double d = std::max({lo[a] - c[a], 0.0, c[a] - (lo[a] + size)});
+    gap_sq += d * d;
+  }
+  return gap_sq;
+}
+
+// The grid cubes that meet the ball B(c, r), in a fixed order (x, then y, then z).
+template <typename Visit>
+void ForBucketsInBall(const Vec3& c, double r, double h, Visit&& visit) {
+  std::array<int64_t, 3> lo{}, hi{};
+  for (int a = 0; a < 3; ++a) {
+    lo[static_cast<size_t>(a)] = static_cast<int64_t>(std::floor((c[a] - r) / h));
+    hi[static_cast<size_t>(a)] = static_cast<int64_t>(std::floor((c[a] + r) / h));
+  }
+  for (int64_t x = lo[0]; x <= hi[0]; ++x)
+    for (int64_t y = lo[1]; y <= hi[1]; ++y)
+      for (int64_t z = lo[2]; z <= hi[2]; ++z) {
+        const Vec3 o(static_cast<double>(x) * h, static_cast<double>(y) * h, static_cast<double>(z) * h);
+        if (BoxGapSquared(c, o, h) <= r * r) visit(GridKey(x, y, z), o);
+      }
+}
+
+}  // namespace
+
+SamplePool::SamplePool(uint64_t seed, double bucket_size) : seed_(seed), h_(bucket_size) {}
+
+size_t SamplePool::points() const {
+  size_t total = 0;
+  for (const Bucket& b : buckets_) total += b.entries.size();
+  return total;
+}
+
+void SamplePool::Grow(Bucket& b, double mark) const {
+  while (b.complete < mark) {
+    // Rate 1 per unit of mark: exponential gaps. Then the position, uniform in the cube.
+    const double gap = -std::log1p(-b.rng.Uniform());
+    const double x = b.rng.Uniform(), y = b.rng.Uniform(), z = b.rng.Uniform();
+    b.complete += gap;
+    b.entries.push_back({b.origin + h_ * Vec3(x, y, z), b.complete, -1});
+  }
+}
+
+std::vector<std::vector<SamplePool::PointId>> SamplePool::Select(const std::vector<Cell>& cells,
+                                                                 const std::vector<char>& wanted, size_t m,
+                                                                 double max_cube_points,
+                                                                 std::vector<double>& marks,
+                                                                 std::vector<uint64_t>* examined) {
+  const size_t n = cells.size();
+  const double h3 = h_ * h_ * h_;
+  std::vector<std::vector<PointId>> out(n);
+  std::vector<double> mark(n, 0.0), cap(n, 0.0), fill(n, -1.0);
+  std::vector<char> pending(n, 0);
+  marks.resize(n, 0.0);
+  if (examined) examined->assign(n, 0);
+  for (size_t i = 0; i < n; ++i) {
+    const double r = cells[i].radius;
+    if (!wanted[i] || !(r > 0.0) || m == 0) continue;
+    const double ball = 4.0 / 3.0 * M_PI * r * r * r;
+    cap[i] = max_cube_points * h3 / (8.0 * r * r * r);
+    // First guess: a little above the mark of the cell's M-th point last time, else from the typical fill.
+    const double guess = i < marks.size() && marks[i] > 0.0 ? 1.2 * marks[i] : 1.25 * static_cast<double>(m) * h3 / (ball * fill_);
+    mark[i] = std::min(cap[i], guess);
+    pending[i] = 1;
+  }
+  std::vector<std::vector<uint32_t>> touched(n);  // per open cell: the buckets its ball meets
+  for (;;) {
+    std::vector<size_t> open;
+    for (size_t i = 0; i < n; ++i)
+      if (pending[i]) open.push_back(i);
+    if (open.empty()) break;
+    // The buckets every open cell's ball meets (keys in parallel; then, serially, found or created in
+    // key order of first use, and each asked for the largest mark any of its cells searches).
+    std::vector<std::vector<std::pair<int64_t, Vec3>>> keys(open.size());
+#pragma omp parallel for schedule(dynamic, 64)
+    for (long li = 0; li < static_cast<long>(open.size()); ++li) {
+      const Cell& cell = cells[open[static_cast<size_t>(li)]];
+      ForBucketsInBall(cell.centre, cell.radius, h_,
+                       [&](int64_t key, const Vec3& origin) { keys[static_cast<size_t>(li)].emplace_back(key, origin); });
+    }
+    std::vector<uint32_t> short_buckets;  // those not yet complete to the mark a cell wants
+    for (size_t li = 0; li < open.size(); ++li) {
+      const size_t i = open[li];
+      touched[i].clear();
+      for (const auto& [key, origin] : keys[li]) {
+        auto [it, inserted] = index_.try_emplace(key, static_cast<uint32_t>(buckets_.size()));
+        if (inserted) buckets_.push_back({key, origin, Rng(seed_, static_cast<uint64_t>(key)), 0.0, 0.0, {}});
+        Bucket& b = buckets_[it->second];
+        if (b.complete >= mark[i]) {
+          touched[i].push_back(it->second);
+          continue;
+        }
+        if (b.wanted == 0.0) short_buckets.push_back(it->second);
+        b.wanted = std::max(b.wanted, mark[i]);
+        touched[i].push_back(it->second);
+      }
+    }
+#pragma omp parallel for schedule(dynamic, 64)
+    for (long k = 0; k < static_cast<long>(short_buckets.size()); ++k) {
+      Bucket& b = buckets_[short_buckets[static_cast<size_t>(k)]];
+      Grow(b, b.wanted);
+      b.wanted = 0.0;
+    }
+
+#pragma omp parallel
+    {
+      std::vector<std::pair<double, PointId>> found;
+#pragma omp for schedule(dynamic, 32)
+      for (long li = 0; li < static_cast<long>(open.size()); ++li) {
+        const size_t i = open[static_cast<size_t>(li)];
+        const Cell& cell = cells[i];
+        const double r2 = cell.radius * cell.radius, t = mark[i];
+        uint64_t seen = 0;
+        found.clear();
+        for (uint32_t b : touched[i]) {
+          const std::vector<Entry_>& entries = buckets_[b].entries;
+          for (size_t e = 0; e < entries.size() && entries[e].mark < t; ++e) {
+            ++seen;
+            const Vec3 q = entries[e].point - cell.centre;
+            if (q.squaredNorm() > r2) continue;
+            bool inside = true;
+            for (size_t k = 0; k < cell.offsets.size() && inside; ++k) inside = cell.offsets[k].dot(q) <= cell.half_sq[k];
+            if (inside) found.emplace_back(entries[e].mark, (static_cast<PointId>(b) << 32) | e);
+          }
+        }
+        if (found.size() >= m || t >= cap[i]) {
+          const size_t keep = std::min(m, found.size());
+          std::nth_element(found.begin(), found.begin() + static_cast<long>(keep) - (keep > 0), found.end());
+          std::sort(found.begin(), found.begin() + static_cast<long>(keep));
+          out[i].resize(keep);
+          for (size_t k = 0; k < keep; ++k) out[i][k] = found[k].second;
+          marks[i] = keep == m ? found[keep - 1].first : 0.0;
+          const double ball_points = t * (4.0 / 3.0 * M_PI * r2 * cell.radius) / h3;
+          fill[i] = static_cast<double>(found.size()) / ball_points;
+          pending[i] = 0;
+        } else {
+          // Too few: search to a higher mark, by the shortfall (at least 1.5×, at most 8× at a time).
+          const double factor = 1.25 * static_cast<double>(m) / std::max<double>(1.0, static_cast<double>(found.size()));
+          mark[i] = std::min(cap[i], t * std::clamp(factor, 1.5, 8.0));
+        }
+        if (examined) (*examined)[i] += seen;
+      }
+    }
+  }
+  std::vector<double> fills;
+  for (double f : fill)
+    if (f > 0.0) fills.push_back(f);
+  if (!fills.empty()) {
+    // A low quantile: most cells then find their M in the first pass.
+    const size_t q = fills.size() / 5;
+    std::nth_element(fills.begin(), fills.begin() + static_cast<long>(q), fills.end());
+    fill_ = std::clamp(fills[q], 0.02, 1.0);
+  }
+  return out;
+}
+
+size_t SamplePool::Evaluate(const Udf& udf, const std::vector<PointId>& ids) {
+  std::vector<PointId> ask;
+  for (PointId id : ids) {
+    Entry_& e = Entry(id);
+    if (e.value != -1) continue;
+    e.value = -2;  // asked in this batch
+    ask.push_back(id);
+  }
+  if (ask.empty()) return 0;
+  std::vector<Vec3> points(ask.size());
+  for (size_t k = 0; k < ask.size(); ++k) points[k] = Entry(ask[k]).point;
+  std::vector<double> d;
+  std::vector<Vec3> g;
+  udf.Evaluate(points, d, g);
+  for (size_t k = 0; k < ask.size(); ++k) {
+    Entry(ask[k]).value = static_cast<int32_t>(values_.size());
+    values_.push_back({d[k], g[k]});
+  }
+  return ask.size();
+}
+
+}  // namespace voroudf

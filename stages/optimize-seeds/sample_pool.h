@@ -1,0 +1,91 @@
+#pragma once
+// One fixed random point set from which every round's cell samples are taken, with the UDF values of the
+// points already asked for (docs/optimize-seeds.md, "Sample pool"). Written by hand: no installed library
+// draws a marked Poisson process lazily over a sparse grid.
+#include <cstddef>
+#include <cstdint>
+#include <unordered_map>
+#include <vector>
+
+#include "common/rng.h"
+#include "common/types.h"
+#include "common/udf.h"
+
+namespace voroudf {
+
+/// A marked Poisson process: in every cube of a grid of side `bucket_size` fixed for the run, points
+/// uniform in the cube arrive in increasing order of a mark u, at rate 1 per unit of u. Restricted to a
+/// region A the process is again Poisson: given their number its points are independent and uniform in A,
+/// and the marks are independent of the positions. So **the M points of lowest mark inside a cell are M
+/// independent uniform points of the cell** — the paper's "M points sampled within its Voronoi cell" — and
+/// a cell that changed little since the last round gets mostly the same points, whose UDF values are kept
+/// here instead of asked again. The points depend on the user's seed and the grid alone, never on the order
+/// in which cells ask or on the thread count.
+class SamplePool {
+ public:
+  using PointId = uint64_t;  ///< bucket index << 32 | point index in the bucket
+
+  /// \pre bucket_size > 0
+  SamplePool(uint64_t seed, double bucket_size);
+
+  /// A cell: the ball B(centre, radius) cut by the half-spaces offset_kᵀ(q − centre) ≤ half_sq_k.
+  struct Cell {
+    Vec3 centre = Vec3::Zero();
+    double radius = 0.0;
+    std::vector<Vec3> offsets;
+    std::vector<double> half_sq;
+  };
+
+  /// For every cell with wanted[i], the ids of its `m` lowest-mark points, in increasing mark; fewer when
+  /// fewer than `m` of its points have a mark at which the ball's bounding cube holds `max_cube_points`
+  /// points on average (the budget of rejection sampling). Grows the pool as far as the cells need; the
+  /// per-cell search runs in parallel. marks: per cell, the mark of its m-th point (0: unknown or fewer),
+  /// read as the first guess of how far to search and updated for the selected cells; it only sets the
+  /// work, never the result. examined (optional): per cell, the pool points looked at.
+  std::vector<std::vector<PointId>> Select(const std::vector<Cell>& cells, const std::vector<char>& wanted, size_t m,
+                                           double max_cube_points, std::vector<double>& marks,
+                                           std::vector<uint64_t>* examined = nullptr);
+
+  /// Asks the UDF, in one batch, at those of `ids` not asked before (each once, in the order given).
+  /// Returns how many were asked.
+  size_t Evaluate(const Udf& udf, const std::vector<PointId>& ids);
+
+  const Vec3& Point(PointId id) const { return Entry(id).point; }
+  /// \pre Evaluate has seen `id`
+  double Distance(PointId id) const { return values_[static_cast<size_t>(Entry(id).value)].distance; }
+  const Vec3& Gradient(PointId id) const { return values_[static_cast<size_t>(Entry(id).value)].gradient; }
+
+  size_t points() const;                              ///< generated so far
+  size_t evaluated() const { return values_.size(); } ///< UDF values held
+
+ private:
+  struct Entry_ {
+    Vec3 point;
+    double mark;
+    int32_t value;  // index into values_, −1: not asked yet
+  };
+  struct Bucket {
+    int64_t key;
+    Vec3 origin;
+    Rng rng;
+    double complete = 0.0;         // every point of mark below this is generated
+    double wanted = 0.0;           // while a Select grows it: the mark to complete it to (else 0)
+    std::vector<Entry_> entries;   // increasing mark
+  };
+  struct Value {
+    double distance;
+    Vec3 gradient;
+  };
+  const Entry_& Entry(PointId id) const { return buckets_[id >> 32].entries[id & 0xffffffffu]; }
+  Entry_& Entry(PointId id) { return buckets_[id >> 32].entries[id & 0xffffffffu]; }
+  void Grow(Bucket& b, double mark) const;  // b complete up to `mark`
+
+  uint64_t seed_;
+  double h_;
+  std::vector<Bucket> buckets_;
+  std::unordered_map<int64_t, uint32_t> index_;  // grid key -> position in buckets_
+  std::vector<Value> values_;
+  double fill_ = 0.5;  // last Select's 20th-percentile share of a ball that its cell fills: the first guess of a mark
+};
+
+}  // namespace voroudf
