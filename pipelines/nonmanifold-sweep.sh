@@ -5,16 +5,17 @@
 # without a non-manifold edge) and the Euler characteristic is the shape's (1, 3, 1): pipelines/tools/curve_check.h.
 # Prints one row per shape and count and the total; the runs go two at a time.
 #
-# Usage: pipelines/nonmanifold-sweep.sh [OUT_DIR] [--build-gvd "ARGS"] [--thin-mesh "ARGS"]
+# Usage: pipelines/nonmanifold-sweep.sh [OUT_DIR] [--optimize-seeds "ARGS"] [--build-gvd "ARGS"] [--thin-mesh "ARGS"]
 #   e.g. --build-gvd "--samples-per-seed 100"
 set -euo pipefail
 ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 BIN=${VOROUDF_BIN:-$ROOT/build/bin}
 OUT=$(mktemp -d)
 [ $# -gt 0 ] && [ "${1#--}" = "$1" ] && { OUT=$1; shift; }
-A_GVD="" A_THIN=""
+A_OPT="" A_GVD="" A_THIN=""
 while (($#)); do
   case "$1" in
+    --optimize-seeds) A_OPT=$2; shift 2 ;;
     --build-gvd) A_GVD=$2; shift 2 ;;
     --thin-mesh) A_THIN=$2; shift 2 ;;
     *) echo "$0: unknown option '$1'" >&2; exit 2 ;;
@@ -28,7 +29,7 @@ one() {
   local shape=$1 count=$2 seed=$3 dir="$OUT/$1-$2-$3"
   mkdir -p "$dir"
   if "$ROOT/pipelines/voroudf.sh" --udf "shape:$shape" -o "$dir" --count "$count" --seed "$seed" --threads 1 \
-      --build-gvd "$A_GVD" --thin-mesh "$A_THIN" > "$dir/log.txt" 2>&1; then
+      --optimize-seeds "$A_OPT" --build-gvd "$A_GVD" --thin-mesh "$A_THIN" > "$dir/log.txt" 2>&1; then
     "$BIN/curve-check" -q --shape "$shape" -i "$dir/mesh.ply" > "$dir/check.json"
   else
     echo "{\"shape\": \"$shape\", \"pass\": false, \"error\": true}" > "$dir/check.json"

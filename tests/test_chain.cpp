@@ -256,11 +256,12 @@ TEST_F(ChainTest, CrossingPlanesKeepTheirNonManifoldLine) {
 // Robustness (docs/thin-mesh.md "Known limits"): of 12 sphere-disc runs (1k-3k seeds, several --seed), 10
 // meet these criteria; the others have a small hole beside the equator.
 TEST_F(ChainTest, SphereWithInnerDiscKeepsItsEquator) {
-  // optimize-seeds snaps seeds onto the equator (rank 2), so the branching edges lie on it.
+  // optimize-seeds snaps seeds onto the equator (rank 2), so the branching edges lie on it. At 2,000 seeds:
+  // pipelines/nonmanifold-sweep.sh passes sphere-disc in 5 of 5 runs there, in 4 of 5 at 1,000.
   if (!HaveOptimizer()) GTEST_SKIP() << "optimize-seeds is not built";
-  const Chain c = RunChain(dir_, "sphere-disc", 1000, 0.0, true);
+  const Chain c = RunChain(dir_, "sphere-disc", 2000, 0.0, true);
   const double diag = MakeShape("sphere-disc")->Domain().Diagonal();
-  const double spacing = 0.016 * diag;
+  const double spacing = 0.016 * diag / std::sqrt(2.0);
   auto dist = [](const Vec3& p) { return std::hypot(std::hypot(p.x(), p.y()) - 0.5, p.z()); };
   auto point = [](double t) { return Vec3(0.5 * std::cos(2 * M_PI * t), 0.5 * std::sin(2 * M_PI * t), 0.0); };
   ExpectNonManifoldCurve(c, dist, point, 0.1 * spacing, 4 * spacing, M_PI, "sphere-disc");

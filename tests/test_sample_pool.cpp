@@ -105,18 +105,22 @@ TEST(SamplePool, OptimizeSeedsAsksAFractionOfTheQueriesForSeedsAsGood) {
   so.count = 600;
   so.seed = 2;
   const SeedCloud in = SampleSeeds(*cube, so, Monitor::Null());
-  auto run = [&](const std::string& mode, uint64_t* queries) {
+  auto run = [&](const std::string& mode, uint64_t* queries, int layers = 3) {
     auto usage = std::make_shared<UdfUsage>();
     const CountingUdf udf(MakeShape("cube"), usage);
     OptimizeSeedsOptions o;
     o.cell_samples = mode;
+    o.pool_layers = layers;
     const SeedCloud out = OptimizeSeeds(udf, in, o, Monitor::Null());
     *queries = usage->queries.load();
     return out;
   };
-  uint64_t fresh_q = 0, pool_q = 0;
-  const SeedCloud fresh = run("fresh", &fresh_q), pooled = run("pool", &pool_q);
-  EXPECT_LT(pool_q, fresh_q / 4) << "pool " << pool_q << " vs fresh " << fresh_q << " queries";
+  uint64_t fresh_q = 0, pool_q = 0, one_layer_q = 0;
+  const SeedCloud fresh = run("fresh", &fresh_q), pooled = run("pool", &pool_q), one_layer = run("pool", &one_layer_q, 1);
+  // Three layers: each round's samples are new only where the cell changed or its layer was not asked yet.
+  EXPECT_LT(pool_q, fresh_q / 3) << "pool " << pool_q << " vs fresh " << fresh_q << " queries";
+  EXPECT_LT(one_layer_q, fresh_q / 6) << "one layer " << one_layer_q << " vs fresh " << fresh_q << " queries";
+  EXPECT_LT(one_layer_q, pool_q);
   // As good: every seed on the surface, all 8 corners found, as many seeds on the edges.
   auto corners = [&](const SeedCloud& s) {
     size_t n = 0;
@@ -128,6 +132,7 @@ TEST(SamplePool, OptimizeSeedsAsksAFractionOfTheQueriesForSeedsAsGood) {
   };
   EXPECT_EQ(corners(fresh), 8u);
   EXPECT_EQ(corners(pooled), 8u);
+  EXPECT_EQ(corners(one_layer), 8u);
   auto edge_seeds = [](const SeedCloud& s) { return std::count(s.rank.begin(), s.rank.end(), uint8_t{2}); };
   EXPECT_NEAR(static_cast<double>(edge_seeds(pooled)), static_cast<double>(edge_seeds(fresh)), 0.15 * edge_seeds(fresh));
 }

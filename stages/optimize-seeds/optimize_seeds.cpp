@@ -30,6 +30,7 @@ void OptimizeSeedsOptions::Check() const {
   if (!(cell_radius_factor > 0.0 && cell_radius_factor <= 10.0)) throw UsageError("--cell-radius-factor must be in (0, 10]");
   if (!(max_step >= 0.0 && max_step <= 100.0)) throw UsageError("--max-step must be in [0, 100]");
   if (cell_samples != "pool" && cell_samples != "fresh") throw UsageError("--cell-samples must be pool or fresh");
+  if (!(pool_layers >= 1 && pool_layers <= 64)) throw UsageError("--pool-layers must be in [1, 64]");
   if (!(sigma_max_spacing >= 0.0 && sigma_max_spacing <= 10.0)) throw UsageError("--sigma-max-spacing must be in [0, 10]");
   if (!(sigma_min_spacing >= 0.0 && sigma_min_spacing <= 10.0)) throw UsageError("--sigma-min-spacing must be in [0, 10]");
   if (!(feature_clearance >= 0.0 && feature_clearance <= 1.0)) throw UsageError("--feature-clearance must be in [0, 1]");
@@ -544,7 +545,7 @@ class Optimizer {
 
   // Takes the cells' samples from one point set for the rest of the run (--cell-samples pool).
   void UsePool(double bucket_size) {
-    pool_ = std::make_unique<SamplePool>(options_.seed, bucket_size);
+    pool_ = std::make_unique<SamplePool>(options_.seed, bucket_size, options_.pool_layers);
     cell_options_.pool = pool_.get();
   }
   const SamplePool* pool() const { return pool_.get(); }

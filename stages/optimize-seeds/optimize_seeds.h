@@ -18,11 +18,14 @@ struct OptimizeSeedsOptions {
   /// show one tangent plane clearly (rank 1 at half the rank threshold) keeps only those; 0: every cell
   /// gets M (--early-samples). Not in the paper, see docs/optimize-seeds.md ("Early samples").
   int early_samples = 0;
-  /// --cell-samples: "fresh" (default), M new rejection draws per cell and round (the paper); "pool", each
-  /// cell's M samples are its M lowest-mark points of one random point set fixed for the run
-  /// (sample_pool.h), so that a cell that moved little keeps most samples and their UDF values: about a
-  /// twelfth of the queries, for slightly worse topology beside branching curves (docs/optimize-seeds.md).
-  std::string cell_samples = "fresh";
+  /// --cell-samples: "pool" (default), each cell's M samples are its M lowest-mark points of one random
+  /// point set fixed for the run (sample_pool.h), so that a cell that moved little keeps most samples and
+  /// their UDF values; "fresh", M new rejection draws per cell and round (the paper). Both are uniform in
+  /// the cell. Not in the paper, see docs/optimize-seeds.md ("Sample pool").
+  std::string cell_samples = "pool";
+  /// --pool-layers: the pool is split into this many independent point sets, which the sampling rounds
+  /// take in turn, so that consecutive rounds see independent samples of a cell (1: every round the same).
+  int pool_layers = 3;
   double gamma = 10.0;            ///< γ, proximity weight, lengths relative to the domain diagonal (paper: 10) (--gamma)
   double delta = 1e-3;            ///< δ, inner loop stops when the gradient changes by less than this, relatively (paper: 1e-3) (--delta)
   int max_outer_iters = 3;        ///< cap on Alg. 1's outer loop (--max-outer-iters; see docs for why 3)

@@ -45,11 +45,12 @@ void ForBucketsInBall(const Vec3& c, double r, double h, Visit&& visit) {
 
 }  // namespace
 
-SamplePool::SamplePool(uint64_t seed, double bucket_size) : seed_(seed), h_(bucket_size) {}
+SamplePool::SamplePool(uint64_t seed, double bucket_size, int layers) : seed_(seed), h_(bucket_size), layers_(layers) {}
 
 size_t SamplePool::points() const {
   size_t total = 0;
-  for (const Bucket& b : buckets_) total += b.entries.size();
+  for (const Bucket& b : buckets_)
+    for (const auto& layer : b.layer) total += layer.size();
   return total;
 }
 
@@ -59,7 +60,9 @@ void SamplePool::Grow(Bucket& b, double mark) const {
     const double gap = -std::log1p(-b.rng.Uniform());
     const double x = b.rng.Uniform(), y = b.rng.Uniform(), z = b.rng.Uniform();
     b.complete += gap;
-    b.entries.push_back({b.origin + h_ * Vec3(x, y, z), b.complete, -1});
+    // Each point joins one layer at random: the layers are independent Poisson processes (thinning).
+    const size_t layer = layers_ > 1 ? static_cast<size_t>(b.rng.Below(static_cast<uint64_t>(layers_))) : 0;
+    b.layer[layer].push_back({b.origin + h_ * Vec3(x, y, z), b.complete, -1});
   }
 }
 
@@ -67,9 +70,9 @@ std::vector<std::vector<SamplePool::PointId>> SamplePool::Select(const std::vect
                                                                  const std::vector<char>& wanted, size_t m,
                                                                  double max_cube_points,
                                                                  std::vector<double>& marks,
-                                                                 std::vector<uint64_t>* examined) {
+                                                                 std::vector<uint64_t>* examined, int layer) {
   const size_t n = cells.size();
-  const double h3 = h_ * h_ * h_;
+  const double h3 = h_ * h_ * h_ * layers_;  // a layer's points: rate 1 / layers per bucket
   std::vector<std::vector<PointId>> out(n);
   std::vector<double> mark(n, 0.0), cap(n, 0.0), fill(n, -1.0);
   std::vector<char> pending(n, 0);
@@ -91,32 +94,38 @@ std::vector<std::vector<SamplePool::PointId>> SamplePool::Select(const std::vect
     for (size_t i = 0; i < n; ++i)
       if (pending[i]) open.push_back(i);
     if (open.empty()) break;
-    // The buckets every open cell's ball meets (keys in parallel; then, serially, found or created in
-    // key order of first use, and each asked for the largest mark any of its cells searches).
-    std::vector<std::vector<std::pair<int64_t, Vec3>>> keys(open.size());
+    // The buckets every open cell's ball meets: looked up in parallel; the missing ones created serially,
+    // in order of first use; then every bucket a cell needs complete to a higher mark is asked for the
+    // largest such mark.
+    std::vector<std::vector<std::pair<int64_t, Vec3>>> missing(open.size());
 #pragma omp parallel for schedule(dynamic, 64)
     for (long li = 0; li < static_cast<long>(open.size()); ++li) {
-      const Cell& cell = cells[open[static_cast<size_t>(li)]];
-      ForBucketsInBall(cell.centre, cell.radius, h_,
-                       [&](int64_t key, const Vec3& origin) { keys[static_cast<size_t>(li)].emplace_back(key, origin); });
-    }
-    std::vector<uint32_t> short_buckets;  // those not yet complete to the mark a cell wants
-    for (size_t li = 0; li < open.size(); ++li) {
-      const size_t i = open[li];
+      const size_t i = open[static_cast<size_t>(li)];
       touched[i].clear();
-      for (const auto& [key, origin] : keys[li]) {
-        auto [it, inserted] = index_.try_emplace(key, static_cast<uint32_t>(buckets_.size()));
-        if (inserted) buckets_.push_back({key, origin, Rng(seed_, static_cast<uint64_t>(key)), 0.0, 0.0, {}});
-        Bucket& b = buckets_[it->second];
-        if (b.complete >= mark[i]) {
+      ForBucketsInBall(cells[i].centre, cells[i].radius, h_, [&](int64_t key, const Vec3& origin) {
+        const auto it = index_.find(key);
+        if (it != index_.end())
           touched[i].push_back(it->second);
-          continue;
-        }
-        if (b.wanted == 0.0) short_buckets.push_back(it->second);
-        b.wanted = std::max(b.wanted, mark[i]);
-        touched[i].push_back(it->second);
-      }
+        else
+          missing[static_cast<size_t>(li)].emplace_back(key, origin);
+      });
     }
+    for (size_t li = 0; li < open.size(); ++li)
+      for (const auto& [key, origin] : missing[li]) {
+        auto [it, inserted] = index_.try_emplace(key, static_cast<uint32_t>(buckets_.size()));
+        if (inserted)
+          buckets_.push_back({key, origin, Rng(seed_, static_cast<uint64_t>(key)), 0.0, 0.0,
+                              std::vector<std::vector<Entry_>>(static_cast<size_t>(layers_))});
+        touched[open[li]].push_back(it->second);
+      }
+    std::vector<uint32_t> short_buckets;  // those not yet complete to the mark a cell wants
+    for (size_t i : open)
+      for (uint32_t b : touched[i]) {
+        Bucket& bucket = buckets_[b];
+        if (bucket.complete >= mark[i]) continue;
+        if (bucket.wanted == 0.0) short_buckets.push_back(b);
+        bucket.wanted = std::max(bucket.wanted, mark[i]);
+      }
 #pragma omp parallel for schedule(dynamic, 64)
     for (long k = 0; k < static_cast<long>(short_buckets.size()); ++k) {
       Bucket& b = buckets_[short_buckets[static_cast<size_t>(k)]];
@@ -135,14 +144,15 @@ std::vector<std::vector<SamplePool::PointId>> SamplePool::Select(const std::vect
         uint64_t seen = 0;
         found.clear();
         for (uint32_t b : touched[i]) {
-          const std::vector<Entry_>& entries = buckets_[b].entries;
+          const std::vector<Entry_>& entries = buckets_[b].layer[static_cast<size_t>(layer)];
           for (size_t e = 0; e < entries.size() && entries[e].mark < t; ++e) {
             ++seen;
             const Vec3 q = entries[e].point - cell.centre;
             if (q.squaredNorm() > r2) continue;
             bool inside = true;
             for (size_t k = 0; k < cell.offsets.size() && inside; ++k) inside = cell.offsets[k].dot(q) <= cell.half_sq[k];
-            if (inside) found.emplace_back(entries[e].mark, (static_cast<PointId>(b) << 32) | e);
+            if (inside)
+              found.emplace_back(entries[e].mark, (static_cast<PointId>(b) << 32) | (static_cast<PointId>(layer) << 26) | e);
           }
         }
         if (found.size() >= m || t >= cap[i]) {

@@ -21,12 +21,16 @@ namespace voroudf {
 /// a cell that changed little since the last round gets mostly the same points, whose UDF values are kept
 /// here instead of asked again. The points depend on the user's seed and the grid alone, never on the order
 /// in which cells ask or on the thread count.
+///
+/// With `layers` > 1 every point joins one of that many layers at random; each layer is again a Poisson
+/// process, independent of the others (thinning), so rounds that take the layers in turn see independent
+/// samples of a cell while each layer's UDF values are still reused.
 class SamplePool {
  public:
-  using PointId = uint64_t;  ///< bucket index << 32 | point index in the bucket
+  using PointId = uint64_t;  ///< bucket index << 32 | layer << 26 | point index in the bucket's layer
 
-  /// \pre bucket_size > 0
-  SamplePool(uint64_t seed, double bucket_size);
+  /// \pre bucket_size > 0, 1 ≤ layers ≤ 64
+  SamplePool(uint64_t seed, double bucket_size, int layers = 1);
 
   /// A cell: the ball B(centre, radius) cut by the half-spaces offset_kᵀ(q − centre) ≤ half_sq_k.
   struct Cell {
@@ -41,10 +45,11 @@ class SamplePool {
   /// points on average (the budget of rejection sampling). Grows the pool as far as the cells need; the
   /// per-cell search runs in parallel. marks: per cell, the mark of its m-th point (0: unknown or fewer),
   /// read as the first guess of how far to search and updated for the selected cells; it only sets the
-  /// work, never the result. examined (optional): per cell, the pool points looked at.
+  /// work, never the result. examined (optional): per cell, the pool points looked at. layer: which
+  /// layer's points (0 ≤ layer < layers).
   std::vector<std::vector<PointId>> Select(const std::vector<Cell>& cells, const std::vector<char>& wanted, size_t m,
                                            double max_cube_points, std::vector<double>& marks,
-                                           std::vector<uint64_t>* examined = nullptr);
+                                           std::vector<uint64_t>* examined = nullptr, int layer = 0);
 
   /// Asks the UDF, in one batch, at those of `ids` not asked before (each once, in the order given).
   /// Returns how many were asked.
@@ -55,6 +60,7 @@ class SamplePool {
   double Distance(PointId id) const { return values_[static_cast<size_t>(Entry(id).value)].distance; }
   const Vec3& Gradient(PointId id) const { return values_[static_cast<size_t>(Entry(id).value)].gradient; }
 
+  int layers() const { return layers_; }
   size_t points() const;                              ///< generated so far
   size_t evaluated() const { return values_.size(); } ///< UDF values held
 
@@ -70,18 +76,19 @@ class SamplePool {
     Rng rng;
     double complete = 0.0;         // every point of mark below this is generated
     double wanted = 0.0;           // while a Select grows it: the mark to complete it to (else 0)
-    std::vector<Entry_> entries;   // increasing mark
+    std::vector<std::vector<Entry_>> layer;  // per layer, increasing mark
   };
   struct Value {
     double distance;
     Vec3 gradient;
   };
-  const Entry_& Entry(PointId id) const { return buckets_[id >> 32].entries[id & 0xffffffffu]; }
-  Entry_& Entry(PointId id) { return buckets_[id >> 32].entries[id & 0xffffffffu]; }
+  const Entry_& Entry(PointId id) const { return buckets_[id >> 32].layer[(id >> 26) & 0x3fu][id & 0x3ffffffu]; }
+  Entry_& Entry(PointId id) { return buckets_[id >> 32].layer[(id >> 26) & 0x3fu][id & 0x3ffffffu]; }
   void Grow(Bucket& b, double mark) const;  // b complete up to `mark`
 
   uint64_t seed_;
   double h_;
+  int layers_;
   std::vector<Bucket> buckets_;
   std::unordered_map<int64_t, uint32_t> index_;  // grid key -> position in buckets_
   std::vector<Value> values_;

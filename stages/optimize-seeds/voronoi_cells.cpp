@@ -124,7 +124,7 @@ CellSamples SampleVoronoiCells(const Udf& udf, const std::vector<Vec3>& seeds, c
     std::vector<uint64_t> examined;
     if (incremental && previous->pool_mark.size() == n) cells.pool_mark = previous->pool_mark;
     chosen = options.pool->Select(shapes, redo, m_max, static_cast<double>(m_max) * options.max_draws_per_sample,
-                                  cells.pool_mark, &examined);
+                                  cells.pool_mark, &examined, static_cast<int>(round % static_cast<uint64_t>(options.pool->layers())));
     for (size_t i = 0; i < n; ++i) {
       if (!redo[i]) continue;
       accepted[i] = chosen[i].size();
