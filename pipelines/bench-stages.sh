@@ -9,6 +9,7 @@
 #   DATA=DIR      folder of the shared meshes (default: ../shared/data beside the checkout; fandisk is
 #                 skipped when it is missing)
 #   COUNT=N       seeds (2500)    REPS=N   runs per input (3)    THREADS=N   --threads of every stage (0)
+#   OPTIMIZE_ARGS="..."  extra options of optimize-seeds, e.g. "--cell-samples fresh" (the paper's sampling)
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 bin=${1:-$root/build/bin}
@@ -16,6 +17,7 @@ data=${DATA:-$root/../shared/data}
 count=${COUNT:-2500}
 reps=${REPS:-3}
 threads=${THREADS:-0}
+read -r -a optimize_args <<< "${OPTIMIZE_ARGS:-}"
 for p in sample-seeds optimize-seeds build-gvd thin-mesh; do
   [ -x "$bin/$p" ] || { echo "bench-stages: $bin/$p is not built" >&2; exit 2; }
 done
@@ -49,7 +51,7 @@ for udf in "${inputs[@]}"; do
   for ((r = 1; r <= reps; ++r)); do
     common=(--udf "$udf" --threads "$threads")
     timed "$work/sample-seeds" "$bin/sample-seeds" "${common[@]}" --count "$count" --seed 1 -o "$work/seeds0.ply"
-    timed "$work/optimize-seeds" "$bin/optimize-seeds" "${common[@]}" -i "$work/seeds0.ply" -o "$work/seeds.ply"
+    timed "$work/optimize-seeds" "$bin/optimize-seeds" "${common[@]}" "${optimize_args[@]}" -i "$work/seeds0.ply" -o "$work/seeds.ply"
     timed "$work/build-gvd" "$bin/build-gvd" "${common[@]}" -i "$work/seeds.ply" -o "$work/thick.ply"
     timed "$work/thin-mesh" "$bin/thin-mesh" "${common[@]}" -i "$work/thick.ply" -o "$work/mesh.ply"
     # The run's total: sums of wall, CPU and queries, the largest peak.

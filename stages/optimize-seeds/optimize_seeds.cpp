@@ -837,6 +837,10 @@ SeedCloud OptimizeSeeds(const Udf& udf, const SeedCloud& input, const OptimizeSe
                    std::to_string(before + added - s.position.size()) + " sheet seeds beside them dropped");
     }
   }
+  if (const SamplePool* pool = opt.pool())
+    monitor.Info("sample pool: " + std::to_string(pool->points()) + " points in " + std::to_string(pool->buckets()) +
+                 " cubes, " + std::to_string(pool->evaluated()) + " with UDF values, " +
+                 Format("%.0f MB", static_cast<double>(pool->bytes()) / 1e6));
   OuterIterationReport final_report;
   CountRanks(s, final_report);
   monitor.Info(Format("done in %.2f s; mean |udf| %.3g (rel); spacing CV %.3f -> %.3f; ",

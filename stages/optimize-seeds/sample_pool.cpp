@@ -54,15 +54,27 @@ size_t SamplePool::points() const {
   return total;
 }
 
+size_t SamplePool::bytes() const {
+  size_t total = values_.capacity() * sizeof(Value) + buckets_.capacity() * sizeof(Bucket) + index_.size() * 32;
+  for (const Bucket& b : buckets_)
+    for (const auto& layer : b.layer) total += layer.capacity() * sizeof(Entry_) + sizeof(layer);
+  return total;
+}
+
 void SamplePool::Grow(Bucket& b, double mark) const {
-  while (b.complete < mark) {
-    // Rate 1 per unit of mark: exponential gaps. Then the position, uniform in the cube.
-    const double gap = -std::log1p(-b.rng.Uniform());
+  // About (mark − complete) new points, spread over the layers.
+  const double expected = std::max(0.0, mark - static_cast<double>(b.complete)) / layers_;
+  for (auto& layer : b.layer) layer.reserve(layer.size() + static_cast<size_t>(1.2 * expected) + 4);
+  while (static_cast<double>(b.complete) < mark) {
+    // Rate 1 per unit of mark: exponential gaps (in single precision, so that the stored mark is the one
+    // the completeness test compares). Then the position, uniform in the cube.
+    const float gap = static_cast<float>(-std::log1p(-b.rng.Uniform()));
     const double x = b.rng.Uniform(), y = b.rng.Uniform(), z = b.rng.Uniform();
-    b.complete += gap;
+    b.complete += std::max(gap, 1e-30f);
     // Each point joins one layer at random: the layers are independent Poisson processes (thinning).
     const size_t layer = layers_ > 1 ? static_cast<size_t>(b.rng.Below(static_cast<uint64_t>(layers_))) : 0;
-    b.layer[layer].push_back({b.origin + h_ * Vec3(x, y, z), b.complete, -1});
+    b.layer[layer].push_back({{static_cast<float>(h_ * x), static_cast<float>(h_ * y), static_cast<float>(h_ * z)},
+                              b.complete, -1});
   }
 }
 
@@ -114,7 +126,7 @@ std::vector<std::vector<SamplePool::PointId>> SamplePool::Select(const std::vect
       for (const auto& [key, origin] : missing[li]) {
         auto [it, inserted] = index_.try_emplace(key, static_cast<uint32_t>(buckets_.size()));
         if (inserted)
-          buckets_.push_back({key, origin, Rng(seed_, static_cast<uint64_t>(key)), 0.0, 0.0,
+          buckets_.push_back({key, origin, Rng(seed_, static_cast<uint64_t>(key)), 0.0f, 0.0,
                               std::vector<std::vector<Entry_>>(static_cast<size_t>(layers_))});
         touched[open[li]].push_back(it->second);
       }
@@ -122,7 +134,7 @@ std::vector<std::vector<SamplePool::PointId>> SamplePool::Select(const std::vect
     for (size_t i : open)
       for (uint32_t b : touched[i]) {
         Bucket& bucket = buckets_[b];
-        if (bucket.complete >= mark[i]) continue;
+        if (static_cast<double>(bucket.complete) >= mark[i]) continue;
         if (bucket.wanted == 0.0) short_buckets.push_back(b);
         bucket.wanted = std::max(bucket.wanted, mark[i]);
       }
@@ -147,7 +159,9 @@ std::vector<std::vector<SamplePool::PointId>> SamplePool::Select(const std::vect
           const std::vector<Entry_>& entries = buckets_[b].layer[static_cast<size_t>(layer)];
           for (size_t e = 0; e < entries.size() && entries[e].mark < t; ++e) {
             ++seen;
-            const Vec3 q = entries[e].point - cell.centre;
+            // As Point(id) − centre, so that callers can check membership to the last bit.
+            const Vec3 q = (buckets_[b].origin + Vec3(entries[e].offset[0], entries[e].offset[1], entries[e].offset[2])) -
+                           cell.centre;
             if (q.squaredNorm() > r2) continue;
             bool inside = true;
             for (size_t k = 0; k < cell.offsets.size() && inside; ++k) inside = cell.offsets[k].dot(q) <= cell.half_sq[k];
@@ -196,7 +210,7 @@ size_t SamplePool::Evaluate(const Udf& udf, const std::vector<PointId>& ids) {
   }
   if (ask.empty()) return 0;
   std::vector<Vec3> points(ask.size());
-  for (size_t k = 0; k < ask.size(); ++k) points[k] = Entry(ask[k]).point;
+  for (size_t k = 0; k < ask.size(); ++k) points[k] = Point(ask[k]);
   std::vector<double> d;
   std::vector<Vec3> g;
   udf.Evaluate(points, d, g);

@@ -55,7 +55,10 @@ class SamplePool {
   /// Returns how many were asked.
   size_t Evaluate(const Udf& udf, const std::vector<PointId>& ids);
 
-  const Vec3& Point(PointId id) const { return Entry(id).point; }
+  Vec3 Point(PointId id) const {
+    const Entry_& e = Entry(id);
+    return buckets_[id >> 32].origin + Vec3(e.offset[0], e.offset[1], e.offset[2]);
+  }
   /// \pre Evaluate has seen `id`
   double Distance(PointId id) const { return values_[static_cast<size_t>(Entry(id).value)].distance; }
   const Vec3& Gradient(PointId id) const { return values_[static_cast<size_t>(Entry(id).value)].gradient; }
@@ -63,18 +66,22 @@ class SamplePool {
   int layers() const { return layers_; }
   size_t points() const;                              ///< generated so far
   size_t evaluated() const { return values_.size(); } ///< UDF values held
+  size_t buckets() const { return buckets_.size(); }
+  size_t bytes() const;                               ///< memory held, roughly
 
  private:
+  // 20 bytes: the pool holds several points per UDF value asked. Single precision is exact for what the
+  // samples need: the points are random anyway, and a mark is compared only with others of the same type.
   struct Entry_ {
-    Vec3 point;
-    double mark;
-    int32_t value;  // index into values_, −1: not asked yet
+    float offset[3];  // from the bucket's origin
+    float mark;
+    int32_t value;    // index into values_, −1: not asked yet
   };
   struct Bucket {
     int64_t key;
     Vec3 origin;
     Rng rng;
-    double complete = 0.0;         // every point of mark below this is generated
+    float complete = 0.0f;         // every point of mark below this is generated
     double wanted = 0.0;           // while a Select grows it: the mark to complete it to (else 0)
     std::vector<std::vector<Entry_>> layer;  // per layer, increasing mark
   };
