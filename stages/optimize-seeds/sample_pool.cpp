@@ -96,40 +96,40 @@ std::vector<std::vector<SamplePool::PointId>> SamplePool::Select(const std::vect
     const double ball = 4.0 / 3.0 * M_PI * r * r * r;
     cap[i] = max_cube_points * h3 / (8.0 * r * r * r);
     // First guess: a little above the mark of the cell's M-th point last time, else from the typical fill.
-    const double guess = i < marks.size() && marks[i] > 0.0 ? 1.2 * marks[i] : 1.25 * static_cast<double>(m) * h3 / (ball * fill_);
+    const double guess = marks[i] > 0.0 ? 1.2 * marks[i] : 1.25 * static_cast<double>(m) * h3 / (ball * fill_);
     mark[i] = std::min(cap[i], guess);
     pending[i] = 1;
   }
-  std::vector<std::vector<uint32_t>> touched(n);  // per open cell: the buckets its ball meets
+  // The buckets every wanted cell's ball meets, once (the balls do not change between passes): looked up in
+  // parallel, the missing ones then created serially in order of first use.
+  std::vector<std::vector<uint32_t>> touched(n);
+  std::vector<std::vector<std::pair<int64_t, Vec3>>> missing(n);
+#pragma omp parallel for schedule(dynamic, 64)
+  for (long li = 0; li < static_cast<long>(n); ++li) {
+    const size_t i = static_cast<size_t>(li);
+    if (!pending[i]) continue;
+    ForBucketsInBall(cells[i].centre, cells[i].radius, h_, [&](int64_t key, const Vec3& origin) {
+      const auto it = index_.find(key);
+      if (it != index_.end())
+        touched[i].push_back(it->second);
+      else
+        missing[i].emplace_back(key, origin);
+    });
+  }
+  for (size_t i = 0; i < n; ++i)
+    for (const auto& [key, origin] : missing[i]) {
+      auto [it, inserted] = index_.try_emplace(key, static_cast<uint32_t>(buckets_.size()));
+      if (inserted)
+        buckets_.push_back({origin, Rng(seed_, static_cast<uint64_t>(key)), 0.0f, 0.0,
+                            std::vector<std::vector<Entry_>>(static_cast<size_t>(layers_))});
+      touched[i].push_back(it->second);
+    }
   for (;;) {
     std::vector<size_t> open;
     for (size_t i = 0; i < n; ++i)
       if (pending[i]) open.push_back(i);
     if (open.empty()) break;
-    // The buckets every open cell's ball meets: looked up in parallel; the missing ones created serially,
-    // in order of first use; then every bucket a cell needs complete to a higher mark is asked for the
-    // largest such mark.
-    std::vector<std::vector<std::pair<int64_t, Vec3>>> missing(open.size());
-#pragma omp parallel for schedule(dynamic, 64)
-    for (long li = 0; li < static_cast<long>(open.size()); ++li) {
-      const size_t i = open[static_cast<size_t>(li)];
-      touched[i].clear();
-      ForBucketsInBall(cells[i].centre, cells[i].radius, h_, [&](int64_t key, const Vec3& origin) {
-        const auto it = index_.find(key);
-        if (it != index_.end())
-          touched[i].push_back(it->second);
-        else
-          missing[static_cast<size_t>(li)].emplace_back(key, origin);
-      });
-    }
-    for (size_t li = 0; li < open.size(); ++li)
-      for (const auto& [key, origin] : missing[li]) {
-        auto [it, inserted] = index_.try_emplace(key, static_cast<uint32_t>(buckets_.size()));
-        if (inserted)
-          buckets_.push_back({key, origin, Rng(seed_, static_cast<uint64_t>(key)), 0.0f, 0.0,
-                              std::vector<std::vector<Entry_>>(static_cast<size_t>(layers_))});
-        touched[open[li]].push_back(it->second);
-      }
+    // Every bucket an open cell needs complete to a higher mark is grown to the largest such mark.
     std::vector<uint32_t> short_buckets;  // those not yet complete to the mark a cell wants
     for (size_t i : open)
       for (uint32_t b : touched[i]) {

@@ -78,7 +78,6 @@ class SamplePool {
     int32_t value;    // index into values_, −1: not asked yet
   };
   struct Bucket {
-    int64_t key;
     Vec3 origin;
     Rng rng;
     float complete = 0.0f;         // every point of mark below this is generated
