@@ -5,6 +5,8 @@
 #include <cmath>
 #include <utility>
 
+#include "common/errors.h"
+
 namespace voroudf {
 namespace {
 
@@ -43,28 +45,62 @@ void ForBucketsInBall(const Vec3& c, double r, double h, Visit&& visit) {
       }
 }
 
+// The Morton (Z-order) code of the grid cube of side h holding p: 21 bits per axis, interleaved.
+uint64_t MortonCode(const Vec3& p, double h) {
+  auto spread = [](uint64_t v) {
+    v &= 0x1fffff;
+    v = (v | v << 32) & 0x1f00000000ffffull;
+    v = (v | v << 16) & 0x1f0000ff0000ffull;
+    v = (v | v << 8) & 0x100f00f00f00f00full;
+    v = (v | v << 4) & 0x10c30c30c30c30c3ull;
+    v = (v | v << 2) & 0x1249249249249249ull;
+    return v;
+  };
+  uint64_t code = 0;
+  for (int a = 0; a < 3; ++a)
+    code |= spread(static_cast<uint64_t>(static_cast<int64_t>(std::floor(p[a] / h)) + kAxisOffset)) << a;
+  return code;
+}
+
 }  // namespace
+
+// Whether the whole cube [lo, lo + size]³ lies outside one of the cell's half-spaces, so that none of its
+// points can be in the cell. With a margin (a point's float offset may round a little past the cube, and
+// the point test computes in its own order): a cube is skipped only when that cannot change a point's
+// answer, so the selection stays the same to the bit.
+bool SamplePool::OutsideSomeHalfSpace(const Cell& cell, const Vec3& lo, double size) {
+  const Vec3 from = lo - cell.centre;
+  const double slack = 1e-6 * size;
+  for (size_t k = 0; k < cell.offsets.size(); ++k) {
+    const Vec3& o = cell.offsets[k];
+    double least = o.dot(from);
+    for (int a = 0; a < 3; ++a) least += std::min(-slack * o[a], (size + slack) * o[a]);
+    const double scale = o.norm() * (from.norm() + 2.0 * size);
+    if (least - cell.half_sq[k] > 1e-9 * scale) return true;
+  }
+  return false;
+}
 
 SamplePool::SamplePool(uint64_t seed, double bucket_size, int layers) : seed_(seed), h_(bucket_size), layers_(layers) {}
 
 size_t SamplePool::points() const {
   size_t total = 0;
   for (const Bucket& b : buckets_)
-    for (const auto& layer : b.layer) total += layer.size();
+    total += b.entries.size();
   return total;
 }
 
 size_t SamplePool::bytes() const {
   size_t total = values_.capacity() * sizeof(Value) + buckets_.capacity() * sizeof(Bucket) + index_.size() * 32;
   for (const Bucket& b : buckets_)
-    for (const auto& layer : b.layer) total += layer.capacity() * sizeof(Entry_) + sizeof(layer);
+    total += b.entries.capacity() * sizeof(Entry_) + b.begin.capacity() * sizeof(uint32_t);
   return total;
 }
 
 void SamplePool::Grow(Bucket& b, double mark) const {
-  // About (mark − complete) new points, spread over the layers.
-  const double expected = std::max(0.0, mark - static_cast<double>(b.complete)) / layers_;
-  for (auto& layer : b.layer) layer.reserve(layer.size() + static_cast<size_t>(1.2 * expected) + 4);
+  const size_t parts = b.begin.size() - 1;
+  std::vector<std::pair<uint32_t, Entry_>> fresh;  // (part, point), in increasing mark
+  fresh.reserve(static_cast<size_t>(1.2 * std::max(0.0, mark - static_cast<double>(b.complete))) + 4);
   while (static_cast<double>(b.complete) < mark) {
     // Rate 1 per unit of mark: exponential gaps (in single precision, so that the stored mark is the one
     // the completeness test compares). Then the position, uniform in the cube.
@@ -73,9 +109,28 @@ void SamplePool::Grow(Bucket& b, double mark) const {
     b.complete += std::max(gap, 1e-30f);
     // Each point joins one layer at random: the layers are independent Poisson processes (thinning).
     const size_t layer = layers_ > 1 ? static_cast<size_t>(b.rng.Below(static_cast<uint64_t>(layers_))) : 0;
-    b.layer[layer].push_back({{static_cast<float>(h_ * x), static_cast<float>(h_ * y), static_cast<float>(h_ * z)},
-                              b.complete, -1});
+    auto sub = [](double u) { return std::min(kSplit - 1, static_cast<int>(u * kSplit)); };
+    const size_t part = layer * kSubCubes + static_cast<size_t>((sub(x) * kSplit + sub(y)) * kSplit + sub(z));
+    fresh.push_back({static_cast<uint32_t>(part),
+                     {{static_cast<float>(h_ * x), static_cast<float>(h_ * y), static_cast<float>(h_ * z)}, b.complete, -1}});
   }
+  if (fresh.empty()) return;
+  // Each part's new points after its old ones (a point keeps its index in its part, so ids stay valid).
+  std::vector<uint32_t> added(parts, 0);
+  for (const auto& f : fresh) ++added[f.first];
+  std::vector<uint32_t> begin(parts + 1, 0);
+  for (size_t p = 0; p < parts; ++p) {
+    begin[p + 1] = begin[p] + static_cast<uint32_t>(b.Size(p)) + added[p];
+  }
+  std::vector<Entry_> entries(begin[parts]);
+  std::vector<uint32_t> next(parts);
+  for (size_t p = 0; p < parts; ++p) {
+    std::copy(b.Part(p), b.Part(p) + b.Size(p), entries.begin() + begin[p]);
+    next[p] = begin[p] + static_cast<uint32_t>(b.Size(p));
+  }
+  for (const auto& f : fresh) entries[next[f.first]++] = f.second;
+  b.entries.swap(entries);
+  b.begin.swap(begin);
 }
 
 std::vector<std::vector<SamplePool::PointId>> SamplePool::Select(const std::vector<Cell>& cells,
@@ -100,6 +155,15 @@ std::vector<std::vector<SamplePool::PointId>> SamplePool::Select(const std::vect
     mark[i] = std::min(cap[i], guess);
     pending[i] = 1;
   }
+  // The cells in Morton order of their centres: neighbouring cells scan the same buckets, which are then
+  // still in the cache (in the seeds' own order they are not, and the scan waits on memory).
+  std::vector<std::pair<uint64_t, size_t>> keyed;
+  for (size_t i = 0; i < n; ++i)
+    if (pending[i]) keyed.emplace_back(MortonCode(cells[i].centre, h_), i);
+  std::sort(keyed.begin(), keyed.end());
+  std::vector<size_t> by_place;
+  by_place.reserve(keyed.size());
+  for (const auto& k : keyed) by_place.push_back(k.second);
   // The buckets every wanted cell's ball meets, once (the balls do not change between passes): looked up in
   // parallel, the missing ones then created serially in order of first use.
   std::vector<std::vector<uint32_t>> touched(n);
@@ -118,15 +182,16 @@ std::vector<std::vector<SamplePool::PointId>> SamplePool::Select(const std::vect
   }
   for (size_t i = 0; i < n; ++i)
     for (const auto& [key, origin] : missing[i]) {
+      if (buckets_.size() >= (size_t{1} << (64 - kBucketShift))) throw NumericalError("sample pool: over 2^24 cubes");
       auto [it, inserted] = index_.try_emplace(key, static_cast<uint32_t>(buckets_.size()));
       if (inserted)
         buckets_.push_back({origin, Rng(seed_, static_cast<uint64_t>(key)), 0.0f, 0.0,
-                            std::vector<std::vector<Entry_>>(static_cast<size_t>(layers_))});
+                            {}, std::vector<uint32_t>(static_cast<size_t>(layers_ * kSubCubes) + 1, 0)});
       touched[i].push_back(it->second);
     }
   for (;;) {
     std::vector<size_t> open;
-    for (size_t i = 0; i < n; ++i)
+    for (size_t i : by_place)
       if (pending[i]) open.push_back(i);
     if (open.empty()) break;
     // Every bucket an open cell needs complete to a higher mark is grown to the largest such mark.
@@ -135,6 +200,9 @@ std::vector<std::vector<SamplePool::PointId>> SamplePool::Select(const std::vect
       for (uint32_t b : touched[i]) {
         Bucket& bucket = buckets_[b];
         if (static_cast<double>(bucket.complete) >= mark[i]) continue;
+        // A part's index has kIndexBits; a mark that high (several GB in one cube) means seeds nearly coincide.
+        if (!(mark[i] < 0.5 * static_cast<double>(kIndexMask)))
+          throw NumericalError("sample pool: a cell needs over 2^27 points in one cube (seeds nearly coincide)");
         if (bucket.wanted == 0.0) short_buckets.push_back(b);
         bucket.wanted = std::max(bucket.wanted, mark[i]);
       }
@@ -156,17 +224,28 @@ std::vector<std::vector<SamplePool::PointId>> SamplePool::Select(const std::vect
         uint64_t seen = 0;
         found.clear();
         for (uint32_t b : touched[i]) {
-          const std::vector<Entry_>& entries = buckets_[b].layer[static_cast<size_t>(layer)];
-          for (size_t e = 0; e < entries.size() && entries[e].mark < t; ++e) {
-            ++seen;
-            // As Point(id) − centre, so that callers can check membership to the last bit.
-            const Vec3 q = (buckets_[b].origin + Vec3(entries[e].offset[0], entries[e].offset[1], entries[e].offset[2])) -
-                           cell.centre;
-            if (q.squaredNorm() > r2) continue;
-            bool inside = true;
-            for (size_t k = 0; k < cell.offsets.size() && inside; ++k) inside = cell.offsets[k].dot(q) <= cell.half_sq[k];
-            if (inside)
-              found.emplace_back(entries[e].mark, (static_cast<PointId>(b) << 32) | (static_cast<PointId>(layer) << 26) | e);
+          const Vec3 origin = buckets_[b].origin;
+          if (OutsideSomeHalfSpace(cell, origin, h_)) continue;
+          const double sub_size = h_ / kSplit, slack = 1e-6 * h_;
+          for (int sub = 0; sub < kSubCubes; ++sub) {
+            const Vec3 sub_origin = origin + sub_size * Vec3(sub / (kSplit * kSplit), (sub / kSplit) % kSplit, sub % kSplit);
+            // Skipped only when no point of it can pass the tests below (with room for the float offsets'
+            // rounding): the selection is the same as without the split.
+            if (BoxGapSquared(cell.centre, sub_origin - Vec3::Constant(slack), sub_size + 2.0 * slack) > r2 * (1.0 + 1e-9))
+              continue;
+            const size_t part = static_cast<size_t>(layer * kSubCubes + sub);
+            const Entry_* entries = buckets_[b].Part(part);
+            const size_t size = buckets_[b].Size(part);
+            for (size_t e = 0; e < size && entries[e].mark < t; ++e) {
+              ++seen;
+              // As Point(id) − centre, so that callers can check membership to the last bit.
+              const Vec3 q = (origin + Vec3(entries[e].offset[0], entries[e].offset[1], entries[e].offset[2])) - cell.centre;
+              if (q.squaredNorm() > r2) continue;
+              bool inside = true;
+              for (size_t k = 0; k < cell.offsets.size() && inside; ++k) inside = cell.offsets[k].dot(q) <= cell.half_sq[k];
+              if (inside)
+                found.emplace_back(entries[e].mark, (static_cast<PointId>(b) << kBucketShift) | (static_cast<PointId>(part) << kIndexBits) | e);
+            }
           }
         }
         if (found.size() >= m || t >= cap[i]) {

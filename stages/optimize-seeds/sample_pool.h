@@ -27,9 +27,9 @@ namespace voroudf {
 /// samples of a cell while each layer's UDF values are still reused.
 class SamplePool {
  public:
-  using PointId = uint64_t;  ///< bucket index << 32 | layer << 26 | point index in the bucket's layer
+  using PointId = uint64_t;  ///< bucket index << 40 | part << 28 | point index in the part (part: layer and sub-cube)
 
-  /// \pre bucket_size > 0, 1 ≤ layers ≤ 64
+  /// \pre bucket_size > 0, 1 ≤ layers ≤ 64 (layers × 8 parts fit in kPartBits)
   SamplePool(uint64_t seed, double bucket_size, int layers = 1);
 
   /// A cell: the ball B(centre, radius) cut by the half-spaces offset_kᵀ(q − centre) ≤ half_sq_k.
@@ -57,7 +57,7 @@ class SamplePool {
 
   Vec3 Point(PointId id) const {
     const Entry_& e = Entry(id);
-    return buckets_[id >> 32].origin + Vec3(e.offset[0], e.offset[1], e.offset[2]);
+    return buckets_[id >> kBucketShift].origin + Vec3(e.offset[0], e.offset[1], e.offset[2]);
   }
   /// \pre Evaluate has seen `id`
   double Distance(PointId id) const { return values_[static_cast<size_t>(Entry(id).value)].distance; }
@@ -82,15 +82,34 @@ class SamplePool {
     Rng rng;
     float complete = 0.0f;         // every point of mark below this is generated
     double wanted = 0.0;           // while a Select grows it: the mark to complete it to (else 0)
-    std::vector<std::vector<Entry_>> layer;  // per layer, increasing mark
+    // The points of every part (layer × kSubCubes + sub-cube) in one array, part p at [begin[p], begin[p + 1]),
+    // each part in increasing mark: one block of memory per bucket, which a cell's scan streams through.
+    std::vector<Entry_> entries;
+    std::vector<uint32_t> begin;
+    size_t Size(size_t part) const { return begin[part + 1] - begin[part]; }
+    const Entry_* Part(size_t part) const { return entries.data() + begin[part]; }
   };
   struct Value {
     double distance;
     Vec3 gradient;
   };
-  const Entry_& Entry(PointId id) const { return buckets_[id >> 32].layer[(id >> 26) & 0x3fu][id & 0x3ffffffu]; }
-  Entry_& Entry(PointId id) { return buckets_[id >> 32].layer[(id >> 26) & 0x3fu][id & 0x3ffffffu]; }
+  // A bucket's points are kept per sub-cube of a 2 × 2 × 2 split, each list in increasing mark, so that a cell
+  // scans only the sub-cubes that meet its ball: with whole cubes, 4 of 5 points looked at lay outside the
+  // cell's ball (fandisk, 2,500 seeds). The split changes no point, mark or layer, only where a point is kept.
+  static constexpr int kSplit = 2;
+  static constexpr int kSubCubes = kSplit * kSplit * kSplit;
+  static constexpr int kIndexBits = 28, kPartBits = 12, kBucketShift = kIndexBits + kPartBits;
+  static constexpr PointId kIndexMask = (PointId{1} << kIndexBits) - 1, kPartMask = (PointId{1} << kPartBits) - 1;
+  const Entry_& Entry(PointId id) const {
+    const Bucket& b = buckets_[id >> kBucketShift];
+    return b.entries[b.begin[(id >> kIndexBits) & kPartMask] + (id & kIndexMask)];
+  }
+  Entry_& Entry(PointId id) {
+    Bucket& b = buckets_[id >> kBucketShift];
+    return b.entries[b.begin[(id >> kIndexBits) & kPartMask] + (id & kIndexMask)];
+  }
   void Grow(Bucket& b, double mark) const;  // b complete up to `mark`
+  static bool OutsideSomeHalfSpace(const Cell& cell, const Vec3& lo, double size);
 
   uint64_t seed_;
   double h_;
