@@ -280,16 +280,24 @@ std::vector<std::vector<SamplePool::PointId>> SamplePool::Select(const std::vect
 }
 
 size_t SamplePool::Evaluate(const Udf& udf, const std::vector<PointId>& ids) {
+  // Which ids have no value yet, looked up in parallel (the entries lie far apart in memory); then those
+  // alone, in the order given, each once.
+  std::vector<char> fresh(ids.size(), 0);
+#pragma omp parallel for schedule(static)
+  for (long k = 0; k < static_cast<long>(ids.size()); ++k)
+    fresh[static_cast<size_t>(k)] = Entry(ids[static_cast<size_t>(k)]).value == -1;
   std::vector<PointId> ask;
-  for (PointId id : ids) {
-    Entry_& e = Entry(id);
+  for (size_t k = 0; k < ids.size(); ++k) {
+    if (!fresh[k]) continue;
+    Entry_& e = Entry(ids[k]);
     if (e.value != -1) continue;
     e.value = -2;  // asked in this batch
-    ask.push_back(id);
+    ask.push_back(ids[k]);
   }
   if (ask.empty()) return 0;
   std::vector<Vec3> points(ask.size());
-  for (size_t k = 0; k < ask.size(); ++k) points[k] = Point(ask[k]);
+#pragma omp parallel for schedule(static)
+  for (long k = 0; k < static_cast<long>(ask.size()); ++k) points[static_cast<size_t>(k)] = Point(ask[static_cast<size_t>(k)]);
   std::vector<double> d;
   std::vector<Vec3> g;
   udf.Evaluate(points, d, g);

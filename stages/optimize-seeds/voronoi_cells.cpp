@@ -125,7 +125,10 @@ CellSamples SampleVoronoiCells(const Udf& udf, const std::vector<Vec3>& seeds, c
     if (incremental && previous->pool_mark.size() == n) cells.pool_mark = previous->pool_mark;
     chosen = options.pool->Select(shapes, redo, m_max, static_cast<double>(m_max) * options.max_draws_per_sample,
                                   cells.pool_mark, &examined, static_cast<int>(round % static_cast<uint64_t>(options.pool->layers())));
-    for (size_t i = 0; i < n; ++i) {
+    // In parallel: the pool's points lie far apart in memory, and one thread would wait on each.
+#pragma omp parallel for schedule(static)
+    for (long li = 0; li < static_cast<long>(n); ++li) {
+      const size_t i = static_cast<size_t>(li);
       if (!redo[i]) continue;
       accepted[i] = chosen[i].size();
       draws[i] = std::max<uint64_t>(examined[i], accepted[i]);
@@ -152,9 +155,10 @@ CellSamples SampleVoronoiCells(const Udf& udf, const std::vector<Vec3>& seeds, c
       std::vector<SamplePool::PointId> ids(at.size());
       for (size_t k = 0; k < at.size(); ++k) ids[k] = chosen[at[k] / m_max][at[k] % m_max];
       cells.reused += at.size() - options.pool->Evaluate(udf, ids);
-      for (size_t k = 0; k < at.size(); ++k) {
-        cand_d[at[k]] = options.pool->Distance(ids[k]);
-        cand_g[at[k]] = options.pool->Gradient(ids[k]);
+#pragma omp parallel for schedule(static)
+      for (long k = 0; k < static_cast<long>(at.size()); ++k) {
+        cand_d[at[static_cast<size_t>(k)]] = options.pool->Distance(ids[static_cast<size_t>(k)]);
+        cand_g[at[static_cast<size_t>(k)]] = options.pool->Gradient(ids[static_cast<size_t>(k)]);
       }
       return;
     }
