@@ -222,11 +222,16 @@ Graph PrunedGraph(const Udf& udf, const std::vector<Vec3>& node, const std::vect
   // (k = 20 neighbours among 200 samples per seed reach about 0.17 seed spacings). On fandisk with 3k seeds
   // 7.4 k of 6.5 M edges are queried and build-gvd takes 2.8 s instead of 4.1 s, with the same output bytes.
   const double eps_udf = options.eps_udf_rel * diag;
-  std::vector<size_t> queried;
-  for (size_t e = 0; e < edges.size(); ++e) {
-    const size_t a = static_cast<size_t>(edges[e].first), b = static_cast<size_t>(edges[e].second);
-    if (0.5 * (node[b] - node[a]).norm() - std::abs(node_d[a] - node_d[b]) > eps_udf) queried.push_back(e);
+  std::vector<char> may_fail(edges.size(), 0);
+#pragma omp parallel for schedule(static)
+  for (long le = 0; le < static_cast<long>(edges.size()); ++le) {
+    const size_t a = static_cast<size_t>(edges[static_cast<size_t>(le)].first);
+    const size_t b = static_cast<size_t>(edges[static_cast<size_t>(le)].second);
+    may_fail[static_cast<size_t>(le)] = 0.5 * (node[b] - node[a]).norm() - std::abs(node_d[a] - node_d[b]) > eps_udf;
   }
+  std::vector<size_t> queried;
+  for (size_t e = 0; e < edges.size(); ++e)
+    if (may_fail[e]) queried.push_back(e);
   std::vector<double> mid_d;
   {
     std::vector<Vec3> mid(queried.size());
@@ -284,7 +289,10 @@ Graph PrunedGraph(const Udf& udf, const std::vector<Vec3>& node, const std::vect
         adj[fill[static_cast<size_t>(edges[e].first)]++] = edges[e].second;
         adj[fill[static_cast<size_t>(edges[e].second)]++] = edges[e].first;
       }
-    for (size_t i = 0; i < n; ++i) std::sort(adj.begin() + static_cast<long>(offset[i]), adj.begin() + static_cast<long>(offset[i + 1]));
+#pragma omp parallel for schedule(static)
+    for (long li = 0; li < static_cast<long>(n); ++li)
+      std::sort(adj.begin() + static_cast<long>(offset[static_cast<size_t>(li)]),
+                adj.begin() + static_cast<long>(offset[static_cast<size_t>(li) + 1]));
   }
   monitor.Info(Format("kNN graph (k=%d): %zu edges; pruned %zu with midpoint UDF > %.3g, %zu with |cos(edge, "
                       "gradient)| > %.3g; %zu left",
