@@ -8,7 +8,9 @@
 # Usage: pipelines/bench-stages.sh [BIN_DIR]      (default: build/bin in the checkout)
 #   DATA=DIR      folder of the shared meshes (default: ../shared/data beside the checkout; fandisk is
 #                 skipped when it is missing)
-#   COUNT=N       seeds (2500)    REPS=N   runs per input (3)    THREADS=N   --threads of every stage (0)
+#   COUNT=N       seeds (2500), or several: COUNT="1000 2500 10000 50000" (scaling)
+#   INPUTS="A;B"  UDF sources to run, separated by ';' (default: the five above)
+#   REPS=N   runs per input (3)    THREADS=N   --threads of every stage (0)
 #   OPTIMIZE_ARGS="..."  extra options of optimize-seeds, e.g. "--cell-samples fresh" (the paper's sampling)
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
@@ -41,10 +43,13 @@ server_pid=$!
 for _ in $(seq 100); do [ -S "$work/sphere.sock" ] && break; sleep 0.05; done
 inputs=("shape:sphere" "exec:/usr/bin/python3 $root/pipelines/udf_server_sphere.py" "unix:$work/sphere.sock" "shape:cube")
 [ -f "$data/cad/cgal_fandisk.off" ] && inputs+=("$data/cad/cgal_fandisk.off")
+[ -n "${INPUTS:-}" ] && IFS=';' read -r -a inputs <<< "$INPUTS"
+read -r -a counts <<< "$count"
 
-echo "| input | stage | s wall | s CPU | UDF queries | peak MB |"
-echo "|---|---|---|---|---|---|"
+echo "| input | seeds | stage | s wall | s CPU | UDF queries | peak MB |"
+echo "|---|---|---|---|---|---|---|"
 for udf in "${inputs[@]}"; do
+ for count in "${counts[@]}"; do
   stages=(sample-seeds optimize-seeds build-gvd thin-mesh)
   for s in "${stages[@]}"; do : > "$work/$s"; done
   : > "$work/total"
@@ -63,9 +68,10 @@ for udf in "${inputs[@]}"; do
   [[ "$udf" == exec:* ]] && name="exec: numpy sphere server"
   [[ "$udf" == unix:* ]] && name="unix: numpy sphere server"
   for s in "${stages[@]}" total; do
-    printf "| %s | %s | %s | %s | %s | %.0f |\n" "$name" "$s" "$(col "$work/$s" 1)" "$(col "$work/$s" 2)" \
+    printf "| %s | %s | %s | %s | %s | %s | %.0f |\n" "$name" "$count" "$s" "$(col "$work/$s" 1)" "$(col "$work/$s" 2)" \
       "$(col "$work/$s" 4)" "$(col "$work/$s" 3 | awk '{ print $1 / 1024 }')"
   done
+ done
 done
 echo
-echo "$count seeds, --threads $threads, medians of $reps runs (this machine: $(nproc) cores)."
+echo "--threads $threads, medians of $reps runs (this machine: $(nproc) cores)."

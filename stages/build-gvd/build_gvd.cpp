@@ -170,19 +170,19 @@ void MakeNodes(const SeedCloud& seeds, const std::vector<Vec3>& samples, const P
 // Step 3: the kNN graph (k = options.knn), undirected, with the edges that leave the surface or jump
 // between sheets pruned; the kept edges as sorted adjacency lists (CSR).
 struct Graph {
-  std::vector<std::pair<int, int>> edges;  // every undirected kNN edge once
+  std::vector<std::pair<int, int>> edges;  // every undirected kNN edge once (empty unless asked for the --graph output)
   std::vector<char> keep;                  // per edge: survived the pruning
   std::vector<size_t> offset;              // CSR: node i's neighbours are adj[offset[i] .. offset[i + 1])
   std::vector<int> adj;
 };
 
 Graph PrunedGraph(const Udf& udf, const std::vector<Vec3>& node, const std::vector<double>& node_d,
-                  const std::vector<Vec3>& node_n, const BuildGvdOptions& options, double diag, BuildGvdStats& stats,
-                  Monitor& monitor) {
+                  const std::vector<Vec3>& node_n, const BuildGvdOptions& options, double diag, bool with_edge_list,
+                  BuildGvdStats& stats, Monitor& monitor) {
   const size_t n = node.size();
   monitor.Debug("node gradients evaluated");
   int kk = 0;
-  const std::vector<int> knn = KNearestAmong(node, options.knn, &kk, monitor, "kNN graph");
+  std::vector<int> knn = KNearestAmong(node, options.knn, &kk, monitor, "kNN graph");
   monitor.Debug("kNN queries done");
   // Undirected edges, each once: (i, j) from i's list when j > i, or when i is not in j's list. No global
   // sort (it took longer than the queries); the order is by i, then by distance, whatever the threads.
@@ -214,6 +214,7 @@ Graph PrunedGraph(const Udf& udf, const std::vector<Vec3>& node, const std::vect
     }
   }
   stats.edges_knn = edges.size();
+  std::vector<int>().swap(knn);  // the memory peak: at 50k seeds the lists and the edges are 0.8 GB each
   monitor.Debug("undirected edges listed");
   // The midpoint test measures the rise of d above the edge's ends, d(mid) - max(d(a), d(b)), so that a field
   // with a floor (nodes at a kink's bottom with d = e > 0, common/projection.h) is judged like an exact one
@@ -232,6 +233,7 @@ Graph PrunedGraph(const Udf& udf, const std::vector<Vec3>& node, const std::vect
   std::vector<size_t> queried;
   for (size_t e = 0; e < edges.size(); ++e)
     if (may_fail[e]) queried.push_back(e);
+  std::vector<char>().swap(may_fail);
   std::vector<double> mid_d;
   {
     std::vector<Vec3> mid(queried.size());
@@ -271,6 +273,7 @@ Graph PrunedGraph(const Udf& udf, const std::vector<Vec3>& node, const std::vect
     }
     keep[e] = 1;
   }
+  std::vector<char>().swap(too_far);
   stats.edges_pruned_udf = pruned_udf;
   stats.edges_pruned_grad = pruned_grad;
   // Adjacency in CSR form, each neighbour list sorted.
@@ -297,6 +300,10 @@ Graph PrunedGraph(const Udf& udf, const std::vector<Vec3>& node, const std::vect
   monitor.Info(Format("kNN graph (k=%d): %zu edges; pruned %zu with midpoint UDF > %.3g, %zu with |cos(edge, "
                       "gradient)| > %.3g; %zu left",
                       kk, stats.edges_knn, pruned_udf, eps_udf, pruned_grad, options.eps_grad, offset[n] / 2));
+  if (!with_edge_list) {  // only --graph writes them
+    std::vector<std::pair<int, int>>().swap(edges);
+    std::vector<char>().swap(keep);
+  }
   return Graph{std::move(edges), std::move(keep), std::move(offset), std::move(adj)};
 }
 
@@ -420,7 +427,7 @@ GvdResult BuildGvd(const Udf& udf, const SeedCloud& seeds, const BuildGvdOptions
   monitor.Debug("node gradients evaluated");
 
   // 3-4. Graph and sweep.
-  const Graph graph = PrunedGraph(udf, node, node_d, node_n, options, diag, stats, monitor);
+  const Graph graph = PrunedGraph(udf, node, node_d, node_n, options, diag, with_graph, stats, monitor);
   std::vector<double> dist;
   std::vector<int> label;
   GeodesicSweep(graph, node, node_seed, &dist, &label, monitor);

@@ -85,6 +85,36 @@ double TangentMisfit(const CellSamples& cells, size_t i, const Vec3& x) {
   return count > 0 ? sum / static_cast<double>(count) : INFINITY;
 }
 
+// The chords of the feature curves, each pair once and sorted: every curve seed (rank 2, with a tangent)
+// and the nearest feature seed ahead of it and behind it along its tangent (and along the other's, when it
+// has one), within 2.5 spacings.
+std::vector<std::pair<int, int>> FeatureChords(const State& s, const std::vector<Vec3>& tangent, double spacing) {
+  const size_t n = s.position.size();
+  std::vector<std::pair<int, int>> chords;
+  const SeedIndex index(s.position);
+  std::vector<int> found;
+  for (size_t i = 0; i < n; ++i) {
+    if (s.rank[i].rank != 2 || tangent[i].isZero()) continue;
+    index.WithinRadius(s.position[i], 2.5 * spacing, found);
+    int best[2] = {-1, -1};
+    for (int j : found) {  // nearest first
+      const size_t uj = static_cast<size_t>(j);
+      if (uj == i || s.rank[uj].rank < 2) continue;
+      const Vec3 e = s.position[uj] - s.position[i];
+      const double along = e.dot(tangent[i]);
+      if (std::abs(along) < 0.8 * e.norm()) continue;
+      if (!tangent[uj].isZero() && std::abs(e.dot(tangent[uj])) < 0.8 * e.norm()) continue;
+      int& side = best[along > 0.0 ? 0 : 1];
+      if (side < 0) side = j;
+    }
+    for (int j : best)
+      if (j >= 0) chords.emplace_back(std::min<int>(static_cast<int>(i), j), std::max<int>(static_cast<int>(i), j));
+  }
+  std::sort(chords.begin(), chords.end());
+  chords.erase(std::unique(chords.begin(), chords.end()), chords.end());
+  return chords;
+}
+
 // Removes the seeds marked in `drop` from every array of the state, keeping the others' order.
 void EraseSeeds(State& s, const std::vector<char>& drop) {
   size_t k = 0;
@@ -102,6 +132,21 @@ void EraseSeeds(State& s, const std::vector<char>& drop) {
   s.normal.resize(k);
   s.rank.resize(k);
   s.space.resize(k);
+}
+
+// Drops the seeds below index `first` that are not on a feature (rank < 2) and lie within `clearance` of a
+// seed from `first` on (seeds just added onto a feature curve), as the feature-seed thinning keeps sheet
+// seeds clear of curve seeds.
+void DropSheetSeedsNear(State& s, size_t first, double clearance) {
+  const SeedIndex index(s.position);
+  std::vector<char> drop(s.position.size(), 0);
+  std::vector<int> near;
+  for (size_t i = first; i < s.position.size(); ++i) {
+    index.WithinRadius(s.position[i], clearance, near);
+    for (int j : near)
+      if (static_cast<size_t>(j) < first && s.rank[static_cast<size_t>(j)].rank < 2) drop[static_cast<size_t>(j)] = 1;
+  }
+  EraseSeeds(s, drop);
 }
 
 // Feature-seed thinning (SeedsBesideFeatures) judged at `where` (the seeds' positions or their step
@@ -350,7 +395,7 @@ class Optimizer {
   // consecutive seeds of a feature curve by a mesh edge, the chord; where the curve bends, the chord's
   // midpoint lies off it by about h²/8R (h the chord, R the curve's radius), and the mesh cuts across the
   // feature. Each round finds every chord — a curve seed and the nearest feature seed ahead of it and
-  // behind it along its tangent (and theirs), within 1.5 spacings — and moves a trial seed from the chord's
+  // behind it along its tangent (and theirs), within 2.5 spacings — and moves a trial seed from the chord's
   // midpoint onto the curve: projection, then the L1 step in its own cell among all seeds, which is what
   // puts any seed onto a feature. The trial seed stays when it lands farther than `tolerance` from the
   // midpoint, strictly between the chord's ends and on a feature (rank ≥ 2). Invariant after the last
@@ -364,30 +409,7 @@ class Optimizer {
       const size_t n = s.position.size();
       const double spacing = MeanSpacing(s.position);
       const std::vector<Vec3> tangent = Tangents(s);
-      std::vector<std::pair<int, int>> chords;
-      {
-        const SeedIndex index(s.position);
-        std::vector<int> found;
-        for (size_t i = 0; i < n; ++i) {
-          if (s.rank[i].rank != 2 || tangent[i].isZero()) continue;
-          index.WithinRadius(s.position[i], 2.5 * spacing, found);
-          int best[2] = {-1, -1};
-          for (int j : found) {  // nearest first
-            const size_t uj = static_cast<size_t>(j);
-            if (uj == i || s.rank[uj].rank < 2) continue;
-            const Vec3 e = s.position[uj] - s.position[i];
-            const double along = e.dot(tangent[i]);
-            if (std::abs(along) < 0.8 * e.norm()) continue;
-            if (!tangent[uj].isZero() && std::abs(e.dot(tangent[uj])) < 0.8 * e.norm()) continue;
-            int& side = best[along > 0.0 ? 0 : 1];
-            if (side < 0) side = j;
-          }
-          for (int j : best)
-            if (j >= 0) chords.emplace_back(std::min<int>(static_cast<int>(i), j), std::max<int>(static_cast<int>(i), j));
-        }
-      }
-      std::sort(chords.begin(), chords.end());
-      chords.erase(std::unique(chords.begin(), chords.end()), chords.end());
+      std::vector<std::pair<int, int>> chords = FeatureChords(s, tangent, spacing);
       // After the first round only chords with a seed added in the last round can have changed.
       if (round > 0)
         chords.erase(std::remove_if(chords.begin(), chords.end(),
@@ -443,17 +465,7 @@ class Optimizer {
       added += last_added;
       if (last_added == 0) break;
     }
-    if (added > 0 && clearance > 0.0) {
-      const SeedIndex index(s.position);
-      std::vector<char> drop(s.position.size(), 0);
-      std::vector<int> near;
-      for (size_t i = n0; i < s.position.size(); ++i) {
-        index.WithinRadius(s.position[i], clearance, near);
-        for (int j : near)
-          if (static_cast<size_t>(j) < n0 && s.rank[static_cast<size_t>(j)].rank < 2) drop[static_cast<size_t>(j)] = 1;
-      }
-      EraseSeeds(s, drop);
-    }
+    if (added > 0 && clearance > 0.0) DropSheetSeedsNear(s, n0, clearance);
     return added;
   }
 

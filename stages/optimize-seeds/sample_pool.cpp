@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <utility>
 
 #include "common/errors.h"
@@ -91,7 +92,7 @@ size_t SamplePool::points() const {
 }
 
 size_t SamplePool::bytes() const {
-  size_t total = values_.capacity() * sizeof(Value) + buckets_.capacity() * sizeof(Bucket) + index_.size() * 32;
+  size_t total = value_chunks_.size() * kChunk * sizeof(Value) + buckets_.capacity() * sizeof(Bucket) + index_.size() * 32;
   for (const Bucket& b : buckets_)
     total += b.entries.capacity() * sizeof(Entry_) + b.begin.capacity() * sizeof(uint32_t);
   return total;
@@ -302,8 +303,11 @@ size_t SamplePool::Evaluate(const Udf& udf, const std::vector<PointId>& ids) {
   std::vector<Vec3> g;
   udf.Evaluate(points, d, g);
   for (size_t k = 0; k < ask.size(); ++k) {
-    Entry(ask[k]).value = static_cast<int32_t>(values_.size());
-    values_.push_back({d[k], g[k]});
+    if (num_values_ >= static_cast<size_t>(std::numeric_limits<int32_t>::max()))
+      throw NumericalError("sample pool: over 2^31 UDF values");
+    if (num_values_ == value_chunks_.size() * kChunk) value_chunks_.push_back(std::make_unique<Value[]>(kChunk));
+    value_chunks_[num_values_ >> kChunkBits][num_values_ & (kChunk - 1)] = {d[k], g[k]};
+    Entry(ask[k]).value = static_cast<int32_t>(num_values_++);
   }
   return ask.size();
 }
