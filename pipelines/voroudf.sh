@@ -6,8 +6,10 @@
 #
 # Usage: pipelines/voroudf.sh --udf SPEC -o DIR [--count N] [--seed S] [--threads T] [--reference MESH]
 #            [--sample-seeds "ARGS"] [--optimize-seeds "ARGS"] [--build-gvd "ARGS"] [--thin-mesh "ARGS"]
-#            [--evaluate "ARGS"]
+#            [--evaluate "ARGS"] [--from STAGE]
 #   --STAGE "ARGS"  extra options for that stage (split on spaces), e.g. --optimize-seeds "--gamma 5"
+#   --from STAGE    start at this stage (optimize-seeds, build-gvd or thin-mesh), with the earlier stages'
+#                   files already in DIR: to try one stage's options or program on the same input
 #   --reference     also run evaluate against this mesh -> DIR/metrics.json
 # Swap a stage for your own program with VOROUDF_<STAGE>=command (e.g. VOROUDF_OPTIMIZE_SEEDS=my-opt):
 # it is called with the same options and files.
@@ -20,8 +22,8 @@ BUILD_GVD=${VOROUDF_BUILD_GVD:-$BIN/build-gvd}
 THIN_MESH=${VOROUDF_THIN_MESH:-$BIN/thin-mesh}
 EVALUATE=${VOROUDF_EVALUATE:-$BIN/evaluate}
 
-usage() { sed -n '5,12p' "${BASH_SOURCE[0]}" | sed 's/^# \{0,1\}//' >&2; exit "${1:-2}"; }
-UDF="" OUT="" COUNT=3000 SEED=0 THREADS=0 REF=""
+usage() { sed -n '7,15p' "${BASH_SOURCE[0]}" | sed 's/^# \{0,1\}//' >&2; exit "${1:-2}"; }
+UDF="" OUT="" COUNT=3000 SEED=0 THREADS=0 REF="" FROM=sample-seeds
 A_SAMPLE="" A_OPT="" A_GVD="" A_THIN="" A_EVAL=""
 while (($#)); do
   case "$1" in
@@ -36,11 +38,23 @@ while (($#)); do
     --build-gvd) A_GVD=$2; shift 2 ;;
     --thin-mesh) A_THIN=$2; shift 2 ;;
     --evaluate) A_EVAL=$2; shift 2 ;;
+    --from) FROM=$2; shift 2 ;;
     -h|--help) usage 0 ;;
     *) echo "$0: unknown option '$1'" >&2; usage ;;
   esac
 done
 [ -n "$UDF" ] && [ -n "$OUT" ] || usage
+# The stages in order, and the file each reads from DIR.
+STAGES=(sample-seeds optimize-seeds build-gvd thin-mesh)
+declare -A INPUT=([optimize-seeds]=seeds0.ply [build-gvd]=seeds.ply [thin-mesh]=thick.ply)
+first=-1
+for i in "${!STAGES[@]}"; do [ "${STAGES[$i]}" = "$FROM" ] && first=$i; done
+[ "$first" -ge 0 ] || { echo "$0: --from: unknown stage '$FROM' (sample-seeds, optimize-seeds, build-gvd or thin-mesh)" >&2; exit 2; }
+if [ "$first" -gt 0 ] && [ ! -s "$OUT/${INPUT[$FROM]}" ]; then
+  echo "$0: --from $FROM needs $OUT/${INPUT[$FROM]} (the earlier stages' output)" >&2
+  exit 2
+fi
+from() { for i in "${!STAGES[@]}"; do [ "${STAGES[$i]}" = "$1" ] && [ "$i" -ge "$first" ] && return 0; done; return 1; }
 mkdir -p "$OUT"
 printf 'stage\tseconds\tudf_queries\tudf_batches\tudf_seconds\n' > "$OUT/timings.tsv"
 
@@ -64,13 +78,13 @@ run() {
 }
 
 # shellcheck disable=SC2086  # the per-stage ARGS are meant to be split
-run sample-seeds $SAMPLE_SEEDS --udf "$UDF" --count "$COUNT" --seed "$SEED" --threads "$THREADS" \
+from sample-seeds && run sample-seeds $SAMPLE_SEEDS --udf "$UDF" --count "$COUNT" --seed "$SEED" --threads "$THREADS" \
   -o "$OUT/seeds0.ply" $A_SAMPLE
 # shellcheck disable=SC2086
-run optimize-seeds $OPTIMIZE_SEEDS --udf "$UDF" --seed "$SEED" --threads "$THREADS" \
+from optimize-seeds && run optimize-seeds $OPTIMIZE_SEEDS --udf "$UDF" --seed "$SEED" --threads "$THREADS" \
   -i "$OUT/seeds0.ply" -o "$OUT/seeds.ply" $A_OPT
 # shellcheck disable=SC2086
-run build-gvd $BUILD_GVD --udf "$UDF" --seed "$SEED" --threads "$THREADS" \
+from build-gvd && run build-gvd $BUILD_GVD --udf "$UDF" --seed "$SEED" --threads "$THREADS" \
   -i "$OUT/seeds.ply" -o "$OUT/thick.ply" --labels "$OUT/labels.ply" $A_GVD
 # shellcheck disable=SC2086
 run thin-mesh $THIN_MESH --udf "$UDF" --threads "$THREADS" \

@@ -36,6 +36,19 @@ case "$WHAT" in
     [ "$(awk -F'\t' '$1 == "optimize-seeds" { print $3 }' "$TMP/c/timings.tsv")" = "-" ] ||
       fail "a swapped stage should have no UDF counts: $(cat "$TMP/c/timings.tsv")"
     [ -s "$TMP/c/mesh.ply" ] || fail "no mesh after swapping a stage"
+    # --from: the chain from a later stage on the earlier stages' files gives the same mesh; without those
+    # files it stops with exit 2 and names the file.
+    mkdir -p "$TMP/e"
+    cp "$TMP/a/seeds.ply" "$TMP/e/"
+    bash "$ROOT/pipelines/voroudf.sh" --udf shape:sphere -o "$TMP/e" --count 500 --seed 3 --from build-gvd 2> /dev/null
+    cmp -s "$TMP/a/mesh.ply" "$TMP/e/mesh.ply" || fail "--from build-gvd gave another mesh"
+    [ "$(cut -f1 "$TMP/e/timings.tsv" | tr '\n' ' ')" = "stage build-gvd thin-mesh " ] ||
+      fail "--from build-gvd ran other stages: $(cat "$TMP/e/timings.tsv")"
+    set +e
+    bash "$ROOT/pipelines/voroudf.sh" --udf shape:sphere -o "$TMP/f" --from thin-mesh 2> "$TMP/err"
+    rc=$?
+    set -e
+    [ "$rc" = 2 ] && grep -q "thick.ply" "$TMP/err" || fail "--from without its input: exit $rc, $(cat "$TMP/err")"
     # A failing stage stops the chain with its exit code.
     set +e
     bash "$ROOT/pipelines/voroudf.sh" --udf shape:nope -o "$TMP/d" 2> /dev/null
@@ -78,6 +91,12 @@ case "$WHAT" in
       sys.exit(0 if 0 < float(r['cd_exact_x1e3']) < float(r['cd_x1e3']) and float(r['cd_floor_x1e3']) > 0 else 1)" \
       "$TMP/bench/results.csv" || fail "exact CD not between 0 and the sampled CD, or no floor"
     grep -q '^cad,broken,.*exit 3' "$TMP/bench/results.csv" || { cat "$TMP/bench/results.csv"; fail "no error row"; }
+    # --reuse --from thin-mesh: the same meshes from the first run's thick duals, only thin-mesh timed.
+    "$ROOT/pipelines/benchmark" --sets cad --data "$TMP/data" --out "$TMP/bench2" --bin "$BIN" -j 2 --count 300 \
+      --reuse "$TMP/bench" --from thin-mesh > "$TMP/log" 2>&1 || { cat "$TMP/log"; fail "benchmark --reuse failed"; }
+    cmp -s "$TMP/bench/runs/cad/ball/mesh.ply" "$TMP/bench2/runs/cad/ball/mesh.ply" || fail "--reuse gave another mesh"
+    [ "$(cut -f1 "$TMP/bench2/runs/cad/ball/timings.tsv" | tr '\n' ' ')" = "stage thin-mesh " ] ||
+      fail "--reuse --from thin-mesh ran other stages"
     ;;
   noise-study)
     # One ball at three noise levels and as a grid: a row each, none failed, and at a value error of 1e-3
