@@ -453,6 +453,16 @@ TEST(EvaluateFeatures, TheCubeTracesItsTwelveEdgesAndEightCornersTheSphereDoesNo
   EXPECT_LT(round.features.recall, 0.2);
   EXPECT_EQ(round.features.corners_matched, 0u);
   EXPECT_TRUE(std::isinf(round.features.feature_max_x1e3)) << "a smooth mesh has no feature edge to be near";
+  // The untraced samples (--feature-misses): none on the cube itself; on the sphere, samples of the cube's
+  // edges (two coordinates at ±0.5 in the normalised frame), as many as the recall leaves out.
+  EXPECT_TRUE(self.features.missed.empty());
+  ASSERT_FALSE(round.features.missed.empty());
+  for (const Vec3& p : round.features.missed) {
+    int on_faces = 0;
+    for (int a = 0; a < 3; ++a) on_faces += std::abs(std::abs(p[a]) - 0.5) < 1e-9 ? 1 : 0;
+    EXPECT_GE(on_faces, 2) << p.transpose();
+  }
+  EXPECT_NEAR(static_cast<double>(round.features.missed.size()) / 10000.0, 1.0 - round.features.recall, 2e-3);
 }
 
 TEST(EvaluateFeatures, ANotchInTheRimGivesItsDepth) {

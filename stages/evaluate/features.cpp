@@ -40,6 +40,7 @@ std::vector<Edge> AllEdges(const TriangleMesh& m) { return BuildEdgeFaces(m.face
 // Share of the samples of `edges` (by length) within `tol` of `targets`, and their mean and largest distance.
 struct Coverage {
   double share = 1, mean = 0, max = 0, length = 0;
+  std::vector<Vec3> missed;  ///< the samples farther than the tolerance
 };
 Coverage Cover(const TriangleMesh& from, const std::vector<Edge>& edges, const TriangleMesh& to,
                const std::vector<Edge>& targets, double tol, size_t samples, Monitor& monitor) {
@@ -49,12 +50,15 @@ Coverage Cover(const TriangleMesh& from, const std::vector<Edge>& edges, const T
   if (targets.empty()) {
     c.share = 0;
     c.mean = c.max = std::numeric_limits<double>::infinity();
+    c.missed = points;
     return c;
   }
   const std::vector<double> d = DistancesToSegments(points, to.vertices, targets, monitor);
   size_t within = 0;
   double sum = 0;
-  for (double x : d) {
+  for (size_t k = 0; k < d.size(); ++k) {
+    const double x = d[k];
+    if (x > tol) c.missed.push_back(points[k]);
     within += x <= tol ? 1 : 0;
     sum += x;
     c.max = std::max(c.max, x);
@@ -116,6 +120,7 @@ FeatureMetrics FeatureRecall(const TriangleMesh& mesh, const TriangleMesh& ref, 
   const Coverage on_edges = Cover(ref, ref_features, mesh, AllEdges(mesh), f.tolerance, samples, monitor);
   f.feature_length = on_edges.length;
   f.recall = on_edges.share;
+  f.missed = on_edges.missed;
   const Coverage on_features = Cover(ref, ref_features, mesh, mesh_features, f.tolerance, samples, monitor);
   f.feature_mean_x1e3 = on_features.mean * 1e3;
   f.feature_max_x1e3 = on_features.max / diagonal * 1e3;

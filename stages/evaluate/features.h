@@ -33,6 +33,7 @@ struct FeatureMetrics {
   double boundary_length = 0;      ///< total length of the reference's boundary edges
   double boundary_recall = 1;      ///< share of it within `tolerance` of a mesh boundary edge (1 if none)
   double boundary_max_x1e3 = 0;    ///< largest distance of a reference boundary sample to the mesh's boundary edges / diagonal, x1e3
+  std::vector<Vec3> missed;        ///< the reference's feature samples farther than `tolerance` from every mesh edge
 };
 
 /// \pre both meshes welded, in the reference's frame; `diagonal` the reference's bbox diagonal there

@@ -10,7 +10,7 @@
 
 int main(int argc, char** argv) {
   voroudf::EvaluateOptions options;
-  std::string input, reference, output;
+  std::string input, reference, output, feature_misses;
   bool timings = false;
 
   voroudf::StageCli cli("evaluate",
@@ -20,6 +20,9 @@ int main(int argc, char** argv) {
   cli.AddInput(&input, "mesh under test (.ply, .obj, .off or .stl)");
   cli.AddExtraInput("--reference", &reference, "reference mesh (.ply, .obj, .off or .stl; - for a PLY on stdin)")->required();
   cli.AddExtraOutput("-o,--output", &output, "write the JSON here (atomically) instead of stdout");
+  cli.AddExtraOutput("--feature-misses", &feature_misses,
+                     "also write the reference's sharp-edge samples that no mesh edge comes within the feature "
+                     "tolerance of (the untraced features), as an edges PLY without edges, in the reference's frame");
   cli.AddSeed(&options.seed);
   auto& app = cli.app();
   app.add_option("--samples", options.samples, "area-uniform surface samples per mesh (CD, HD, ECD)");
@@ -47,6 +50,14 @@ int main(int argc, char** argv) {
         throw voroudf::OutputError("stdout", "cannot write");
     } else {
       voroudf::WriteFileAtomically(output, json);
+    }
+    if (!feature_misses.empty()) {
+      // Back from the normalised frame to the reference's own coordinates, to be seen over it in a viewer.
+      voroudf::EdgeSet misses;
+      for (const voroudf::Vec3& p : metrics.features.missed)
+        misses.vertices.push_back(p / metrics.frame.scale + metrics.frame.center);
+      voroudf::WriteEdgesPly(feature_misses, misses, cli.provenance());
+      monitor.Info("wrote " + std::to_string(misses.vertices.size()) + " untraced feature samples to " + feature_misses);
     }
     monitor.Info("done in " + std::to_string(seconds) + " s");
   });
