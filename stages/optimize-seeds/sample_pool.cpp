@@ -245,7 +245,8 @@ std::vector<std::vector<SamplePool::PointId>> SamplePool::Select(const std::vect
               bool inside = true;
               for (size_t k = 0; k < cell.offsets.size() && inside; ++k) inside = cell.offsets[k].dot(q) <= cell.half_sq[k];
               if (inside)
-                found.emplace_back(entries[e].mark, (static_cast<PointId>(b) << kBucketShift) | (static_cast<PointId>(part) << kIndexBits) | e);
+                found.emplace_back(entries[e].mark, (static_cast<PointId>(b) << kBucketShift) |
+                                                        (static_cast<PointId>(part) << kIndexBits) | e);
             }
           }
         }
