@@ -135,7 +135,8 @@ std::vector<Vec3> DrawSamples(const SeedCloud& seeds, const Box& box, const Buil
 // along a Morton curve; a node in the Morton cell of an earlier one is dropped. node_seed: the seed index of
 // a seed node, -1 for a sample.
 void MakeNodes(const SeedCloud& seeds, const std::vector<Vec3>& samples, const ProjectionResult& projected,
-               const Box& box, BuildGvdStats& stats, std::vector<Vec3>* node_out, std::vector<int>* node_seed_out) {
+               const Box& box, BuildGvdStats& stats, std::vector<Vec3>* node_out, std::vector<int>* node_seed_out,
+               std::vector<size_t>* raw_out) {
   const size_t num_seeds = seeds.size(), total = samples.size();
   std::vector<Vec3> raw;
   raw.reserve(num_seeds + projected.num_converged);
@@ -148,10 +149,16 @@ void MakeNodes(const SeedCloud& seeds, const std::vector<Vec3>& samples, const P
   std::vector<size_t> order(raw.size());
   std::iota(order.begin(), order.end(), size_t{0});
   std::sort(order.begin(), order.end(), [&](size_t a, size_t b) { return code[a] != code[b] ? code[a] < code[b] : a < b; });
+  // Which projected sample each node is (its index in `samples`), for the UDF values the projection left.
+  std::vector<size_t> sample_of(raw.size(), 0);
+  for (size_t i = 0, r = num_seeds; i < total; ++i)
+    if (projected.converged[i]) sample_of[r++] = i;
   std::vector<Vec3> node;
   std::vector<int> node_seed;  // seed index of a seed node, -1 for a sample
+  std::vector<size_t> node_sample;
   node.reserve(raw.size());
   node_seed.reserve(raw.size());
+  node_sample.reserve(raw.size());
   for (size_t k = 0; k < order.size(); ++k) {
     const size_t r = order[k];
     const bool is_seed = r < num_seeds;
@@ -162,9 +169,11 @@ void MakeNodes(const SeedCloud& seeds, const std::vector<Vec3>& samples, const P
     }
     node.push_back(raw[r]);
     node_seed.push_back(is_seed ? static_cast<int>(r) : -1);
+    node_sample.push_back(is_seed ? 0 : sample_of[r]);
   }
   *node_out = std::move(node);
   *node_seed_out = std::move(node_seed);
+  *raw_out = std::move(node_sample);
 }
 
 // Step 3: the kNN graph (k = options.knn), undirected, with the edges that leave the surface or jump
@@ -410,7 +419,8 @@ GvdResult BuildGvd(const Udf& udf, const SeedCloud& seeds, const BuildGvdOptions
   // 2. Nodes.
   std::vector<Vec3> node;
   std::vector<int> node_seed;
-  MakeNodes(seeds, samples, projected, box, stats, &node, &node_seed);
+  std::vector<size_t> node_sample;
+  MakeNodes(seeds, samples, projected, box, stats, &node, &node_seed, &node_sample);
   const size_t n = node.size();
   stats.nodes = n;
   if (stats.seeds_duplicate > 0)
@@ -420,10 +430,28 @@ GvdResult BuildGvd(const Udf& udf, const SeedCloud& seeds, const BuildGvdOptions
                       "%zu duplicates dropped; graph of %zu nodes (%zu seeds)",
                       total, in_space, total - in_space, stats.samples_projected, stats.samples_duplicate, n,
                       num_seeds - stats.seeds_duplicate));
-  // Gradients at the nodes (on the zero set this is a surface normal of either orientation).
-  std::vector<double> node_d;
-  std::vector<Vec3> node_n;
-  udf.Evaluate(node, node_d, node_n);
+  // UDF values and gradients at the nodes (on the zero set a surface normal of either orientation): a
+  // sample's are the projection's last evaluation, at that very point; only the seeds are asked (a third
+  // of the stage's queries were these again).
+  std::vector<double> node_d(n);
+  std::vector<Vec3> node_n(n);
+  {
+    std::vector<Vec3> at_seeds;
+    for (size_t i = 0; i < n; ++i)
+      if (node_seed[i] >= 0) at_seeds.push_back(node[i]);
+    std::vector<double> seed_d;
+    std::vector<Vec3> seed_n;
+    udf.Evaluate(at_seeds, seed_d, seed_n);
+    for (size_t i = 0, k = 0; i < n; ++i) {
+      if (node_seed[i] >= 0) {
+        node_d[i] = seed_d[k];
+        node_n[i] = seed_n[k++];
+      } else {
+        node_d[i] = projected.distance[node_sample[i]];
+        node_n[i] = projected.gradient[node_sample[i]];
+      }
+    }
+  }
   monitor.Debug("node gradients evaluated");
 
   // 3-4. Graph and sweep.
