@@ -133,10 +133,11 @@ std::vector<Vec3> DrawSamples(const SeedCloud& seeds, const Box& box, const Buil
 
 // Step 2: the graph nodes, seeds first (so that they win Morton-cell ties), then converged samples, sorted
 // along a Morton curve; a node in the Morton cell of an earlier one is dropped. node_seed: the seed index of
-// a seed node, -1 for a sample.
+// a seed node, -1 for a sample. node_d, node_n: a sample node's UDF value and gradient from the projection
+// (its last evaluation, at that point); 0 and zero for a seed node, which the caller asks the UDF for.
 void MakeNodes(const SeedCloud& seeds, const std::vector<Vec3>& samples, const ProjectionResult& projected,
                const Box& box, BuildGvdStats& stats, std::vector<Vec3>* node_out, std::vector<int>* node_seed_out,
-               std::vector<size_t>* raw_out) {
+               std::vector<double>* node_d_out, std::vector<Vec3>* node_n_out) {
   const size_t num_seeds = seeds.size(), total = samples.size();
   std::vector<Vec3> raw;
   raw.reserve(num_seeds + projected.num_converged);
@@ -155,10 +156,12 @@ void MakeNodes(const SeedCloud& seeds, const std::vector<Vec3>& samples, const P
     if (projected.converged[i]) sample_of[r++] = i;
   std::vector<Vec3> node;
   std::vector<int> node_seed;  // seed index of a seed node, -1 for a sample
-  std::vector<size_t> node_sample;
+  std::vector<double> node_d;
+  std::vector<Vec3> node_n;
   node.reserve(raw.size());
   node_seed.reserve(raw.size());
-  node_sample.reserve(raw.size());
+  node_d.reserve(raw.size());
+  node_n.reserve(raw.size());
   for (size_t k = 0; k < order.size(); ++k) {
     const size_t r = order[k];
     const bool is_seed = r < num_seeds;
@@ -169,11 +172,13 @@ void MakeNodes(const SeedCloud& seeds, const std::vector<Vec3>& samples, const P
     }
     node.push_back(raw[r]);
     node_seed.push_back(is_seed ? static_cast<int>(r) : -1);
-    node_sample.push_back(is_seed ? 0 : sample_of[r]);
+    node_d.push_back(is_seed ? 0.0 : projected.distance[sample_of[r]]);
+    node_n.push_back(is_seed ? Vec3::Zero() : projected.gradient[sample_of[r]]);
   }
   *node_out = std::move(node);
   *node_seed_out = std::move(node_seed);
-  *raw_out = std::move(node_sample);
+  *node_d_out = std::move(node_d);
+  *node_n_out = std::move(node_n);
 }
 
 // Step 3: the kNN graph (k = options.knn), undirected, with the edges that leave the surface or jump
@@ -189,7 +194,6 @@ Graph PrunedGraph(const Udf& udf, const std::vector<Vec3>& node, const std::vect
                   const std::vector<Vec3>& node_n, const BuildGvdOptions& options, double diag, bool with_edge_list,
                   BuildGvdStats& stats, Monitor& monitor) {
   const size_t n = node.size();
-  monitor.Debug("node gradients evaluated");
   int kk = 0;
   std::vector<int> knn = KNearestAmong(node, options.knn, &kk, monitor, "kNN graph");
   monitor.Debug("kNN queries done");
@@ -419,8 +423,9 @@ GvdResult BuildGvd(const Udf& udf, const SeedCloud& seeds, const BuildGvdOptions
   // 2. Nodes.
   std::vector<Vec3> node;
   std::vector<int> node_seed;
-  std::vector<size_t> node_sample;
-  MakeNodes(seeds, samples, projected, box, stats, &node, &node_seed, &node_sample);
+  std::vector<double> node_d;
+  std::vector<Vec3> node_n;
+  MakeNodes(seeds, samples, projected, box, stats, &node, &node_seed, &node_d, &node_n);
   const size_t n = node.size();
   stats.nodes = n;
   if (stats.seeds_duplicate > 0)
@@ -431,10 +436,8 @@ GvdResult BuildGvd(const Udf& udf, const SeedCloud& seeds, const BuildGvdOptions
                       total, in_space, total - in_space, stats.samples_projected, stats.samples_duplicate, n,
                       num_seeds - stats.seeds_duplicate));
   // UDF values and gradients at the nodes (on the zero set a surface normal of either orientation): a
-  // sample's are the projection's last evaluation, at that very point; only the seeds are asked (a third
-  // of the stage's queries were these again).
-  std::vector<double> node_d(n);
-  std::vector<Vec3> node_n(n);
+  // sample's are the projection's last evaluation, at that very point (MakeNodes); only the seeds are asked
+  // (a third of the stage's queries were the samples' again).
   {
     std::vector<Vec3> at_seeds;
     for (size_t i = 0; i < n; ++i)
@@ -442,15 +445,11 @@ GvdResult BuildGvd(const Udf& udf, const SeedCloud& seeds, const BuildGvdOptions
     std::vector<double> seed_d;
     std::vector<Vec3> seed_n;
     udf.Evaluate(at_seeds, seed_d, seed_n);
-    for (size_t i = 0, k = 0; i < n; ++i) {
+    for (size_t i = 0, k = 0; i < n; ++i)
       if (node_seed[i] >= 0) {
         node_d[i] = seed_d[k];
         node_n[i] = seed_n[k++];
-      } else {
-        node_d[i] = projected.distance[node_sample[i]];
-        node_n[i] = projected.gradient[node_sample[i]];
       }
-    }
   }
   monitor.Debug("node gradients evaluated");
 

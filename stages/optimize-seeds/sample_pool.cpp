@@ -7,6 +7,7 @@
 #include <utility>
 
 #include "common/errors.h"
+#include "common/morton.h"
 
 namespace voroudf {
 namespace {
@@ -46,23 +47,6 @@ void ForBucketsInBall(const Vec3& c, double r, double h, Visit&& visit) {
       }
 }
 
-// The Morton (Z-order) code of the grid cube of side h holding p: 21 bits per axis, interleaved.
-uint64_t MortonCode(const Vec3& p, double h) {
-  auto spread = [](uint64_t v) {
-    v &= 0x1fffff;
-    v = (v | v << 32) & 0x1f00000000ffffull;
-    v = (v | v << 16) & 0x1f0000ff0000ffull;
-    v = (v | v << 8) & 0x100f00f00f00f00full;
-    v = (v | v << 4) & 0x10c30c30c30c30c3ull;
-    v = (v | v << 2) & 0x1249249249249249ull;
-    return v;
-  };
-  uint64_t code = 0;
-  for (int a = 0; a < 3; ++a)
-    code |= spread(static_cast<uint64_t>(static_cast<int64_t>(std::floor(p[a] / h)) + kAxisOffset)) << a;
-  return code;
-}
-
 }  // namespace
 
 // Whether the whole cube [lo, lo + size]³ lies outside one of the cell's half-spaces, so that none of its
@@ -92,7 +76,7 @@ size_t SamplePool::points() const {
 }
 
 size_t SamplePool::bytes() const {
-  size_t total = value_chunks_.size() * kChunk * sizeof(Value) + buckets_.capacity() * sizeof(Bucket) + index_.size() * 32;
+  size_t total = values_.capacity() * sizeof(Value) + buckets_.capacity() * sizeof(Bucket) + index_.size() * 32;
   for (const Bucket& b : buckets_)
     total += b.entries.capacity() * sizeof(Entry_) + b.begin.capacity() * sizeof(uint32_t);
   return total;
@@ -158,13 +142,16 @@ std::vector<std::vector<SamplePool::PointId>> SamplePool::Select(const std::vect
   }
   // The cells in Morton order of their centres: neighbouring cells scan the same buckets, which are then
   // still in the cache (in the seeds' own order they are not, and the scan waits on memory).
-  std::vector<std::pair<uint64_t, size_t>> keyed;
+  std::vector<Vec3> centres;
+  std::vector<size_t> pending_index;
   for (size_t i = 0; i < n; ++i)
-    if (pending[i]) keyed.emplace_back(MortonCode(cells[i].centre, h_), i);
-  std::sort(keyed.begin(), keyed.end());
+    if (pending[i]) {
+      centres.push_back(cells[i].centre);
+      pending_index.push_back(i);
+    }
   std::vector<size_t> by_place;
-  by_place.reserve(keyed.size());
-  for (const auto& k : keyed) by_place.push_back(k.second);
+  by_place.reserve(centres.size());
+  for (size_t k : MortonOrder(centres, BoundingBox(centres))) by_place.push_back(pending_index[k]);
   // The buckets every wanted cell's ball meets, once (the balls do not change between passes): looked up in
   // parallel, the missing ones then created serially in order of first use.
   std::vector<std::vector<uint32_t>> touched(n);
@@ -304,11 +291,10 @@ size_t SamplePool::Evaluate(const Udf& udf, const std::vector<PointId>& ids) {
   std::vector<Vec3> g;
   udf.Evaluate(points, d, g);
   for (size_t k = 0; k < ask.size(); ++k) {
-    if (num_values_ >= static_cast<size_t>(std::numeric_limits<int32_t>::max()))
+    if (values_.size() >= static_cast<size_t>(std::numeric_limits<int32_t>::max()))
       throw NumericalError("sample pool: over 2^31 UDF values");
-    if (num_values_ == value_chunks_.size() * kChunk) value_chunks_.push_back(std::make_unique<Value[]>(kChunk));
-    value_chunks_[num_values_ >> kChunkBits][num_values_ & (kChunk - 1)] = {d[k], g[k]};
-    Entry(ask[k]).value = static_cast<int32_t>(num_values_++);
+    Entry(ask[k]).value = static_cast<int32_t>(values_.size());
+    values_.push_back({d[k], g[k]});
   }
   return ask.size();
 }

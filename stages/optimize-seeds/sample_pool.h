@@ -4,7 +4,6 @@
 // draws a marked Poisson process lazily over a sparse grid.
 #include <cstddef>
 #include <cstdint>
-#include <memory>
 #include <unordered_map>
 #include <vector>
 
@@ -61,12 +60,12 @@ class SamplePool {
     return buckets_[id >> kBucketShift].origin + Vec3(e.offset[0], e.offset[1], e.offset[2]);
   }
   /// \pre Evaluate has seen `id`
-  double Distance(PointId id) const { return ValueAt(static_cast<size_t>(Entry(id).value)).distance; }
-  const Vec3& Gradient(PointId id) const { return ValueAt(static_cast<size_t>(Entry(id).value)).gradient; }
+  double Distance(PointId id) const { return values_[static_cast<size_t>(Entry(id).value)].distance; }
+  const Vec3& Gradient(PointId id) const { return values_[static_cast<size_t>(Entry(id).value)].gradient; }
 
   int layers() const { return layers_; }
   size_t points() const;                              ///< generated so far
-  size_t evaluated() const { return num_values_; }    ///< UDF values held
+  size_t evaluated() const { return values_.size(); } ///< UDF values held
   size_t buckets() const { return buckets_.size(); }
   size_t bytes() const;                               ///< memory held, roughly
 
@@ -117,12 +116,7 @@ class SamplePool {
   int layers_;
   std::vector<Bucket> buckets_;
   std::unordered_map<int64_t, uint32_t> index_;  // grid key -> position in buckets_
-  // The UDF values in chunks of 2^16, never moved: a growing array would hold its old and new copies at
-  // once when it reallocates (three times the values at that moment, the stage's memory peak).
-  static constexpr size_t kChunkBits = 16, kChunk = size_t{1} << kChunkBits;
-  std::vector<std::unique_ptr<Value[]>> value_chunks_;
-  size_t num_values_ = 0;
-  const Value& ValueAt(size_t i) const { return value_chunks_[i >> kChunkBits][i & (kChunk - 1)]; }
+  std::vector<Value> values_;
   double fill_ = 0.5;  // last Select's 20th-percentile share of a ball that its cell fills: the first guess of a mark
 };
 
