@@ -8,6 +8,7 @@
 #include <set>
 
 #include "common/errors.h"
+#include "common/mesh_udf.h"
 #include "common/projection.h"
 #include "common/rng.h"
 #include "common/shapes.h"
@@ -274,6 +275,55 @@ TEST(TangentRank, CountsThePlanesAndGivesTheirNullSpace) {
   almost.push_back(Vec3(1, 0, 0));
   EXPECT_EQ(ComputeTangentRank(almost.data(), almost.size(), 0.25).rank, 1);
   EXPECT_EQ(ComputeTangentRank(almost.data(), 0, 0.25).rank, 0);
+}
+
+// Normals of a cell on a crease between two planes turned by `angle` about the y axis, `share` of them on the
+// second plane and `wedge` of them spread evenly between the two (the samples beyond a convex crease),
+// each side of each plane alike.
+std::vector<Vec3> CreaseNormals(double angle, double share, double wedge, size_t count) {
+  std::vector<Vec3> n;
+  for (size_t k = 0; k < count; ++k) {
+    const double u = (static_cast<double>(k) + 0.5) / static_cast<double>(count);
+    double a = 0.0;
+    if (u < wedge) a = angle * u / wedge;
+    else if (u < wedge + share) a = angle;
+    const Vec3 v(std::sin(a), 0.0, std::cos(a));
+    n.push_back(k % 2 ? v : Vec3(-v));
+  }
+  return n;
+}
+
+TEST(TangentRank, ShallowCreaseSeenByTheTwoPlaneTestAndCurvedSheetNot) {
+  const double deg = M_PI / 180.0, share = SecondPlaneShare(0.4);
+  EXPECT_NEAR(share, 0.16 / 1.16, 1e-12);
+  // At the share SecondPlaneShare gives, the singular-value test sees a 90° crease just so.
+  const auto right = CreaseNormals(90 * deg, share + 0.01, 0.0, 400);
+  EXPECT_EQ(ComputeTangentRank(right.data(), right.size(), 0.4).rank, 2);
+  for (double angle : {32.0, 35.0, 40.0}) {
+    const auto n = CreaseNormals(angle * deg, 0.45, 0.1, 100);
+    const TangentRank r = ComputeTangentRank(n.data(), n.size(), 0.4);
+    EXPECT_EQ(r.rank, 1) << angle << "°: tan(θ/2) < 0.4, the paper's test misses it";
+    EXPECT_TRUE(SeesTwoPlanes(n.data(), n.size(), r, 30 * deg, BlindCreaseAngle(0.4), share, 6.0)) << angle;
+  }
+  // Above 2·atan(τ) = 43.6° the singular-value test sees the crease itself; the two-plane test stays out.
+  EXPECT_NEAR(BlindCreaseAngle(0.4) / deg, 43.6028, 1e-3);
+  const auto steep = CreaseNormals(60 * deg, 0.45, 0.1, 100);
+  const TangentRank steep_rank = ComputeTangentRank(steep.data(), steep.size(), 0.4);
+  EXPECT_EQ(steep_rank.rank, 2);
+  EXPECT_FALSE(SeesTwoPlanes(steep.data(), steep.size(), steep_rank, 30 * deg, BlindCreaseAngle(0.4), share, 6.0));
+  // Below the angle, below the share, or one sheet curved by 40°, 80° or 100° (normals evenly spread).
+  auto below = CreaseNormals(25 * deg, 0.45, 0.1, 100);
+  EXPECT_FALSE(SeesTwoPlanes(below.data(), below.size(), ComputeTangentRank(below.data(), below.size(), 0.4),
+                             30 * deg, BlindCreaseAngle(0.4), share, 6.0));
+  auto few = CreaseNormals(40 * deg, 0.08, 0.0, 100);
+  EXPECT_FALSE(SeesTwoPlanes(few.data(), few.size(), ComputeTangentRank(few.data(), few.size(), 0.4), 30 * deg,
+                             BlindCreaseAngle(0.4), share, 6.0));
+  for (double spread : {40.0, 80.0, 100.0}) {
+    const auto curved = CreaseNormals(spread * deg, 0.0, 1.0, 100);
+    EXPECT_FALSE(SeesTwoPlanes(curved.data(), curved.size(), ComputeTangentRank(curved.data(), curved.size(), 0.4),
+                               30 * deg, BlindCreaseAngle(0.4), share, 6.0))
+        << spread;
+  }
 }
 
 // ---------------------------------------------------------------------------------------------- repulsion
@@ -624,6 +674,48 @@ TEST(OptimizeSeeds, SphereWithDiscRankTwoSeedsOnTheEquator) {
   ExpectRankTwoOnFeatures("sphere-disc", equator, equator, 20, 2.0);
 }
 
+// A closed "house": the box [-1,1]² × [0,1] with a roof whose two faces rise 17.5° each way to a ridge along
+// x, so the ridge turns by 35° — below the 44° the singular-value test can see — and the eaves by 72.5°.
+std::unique_ptr<MeshUdf> HouseUdf() {
+  const double ridge = 1.0 + std::tan(17.5 * M_PI / 180.0);
+  TriangleMesh m;
+  m.vertices = {Vec3(-1, -1, 0), Vec3(1, -1, 0), Vec3(1, 1, 0), Vec3(-1, 1, 0),   // floor
+                Vec3(-1, -1, 1), Vec3(1, -1, 1), Vec3(1, 1, 1), Vec3(-1, 1, 1),   // eaves
+                Vec3(-1, 0, ridge), Vec3(1, 0, ridge)};                           // ridge
+  m.faces = {{0, 2, 1}, {0, 3, 2}, {0, 1, 5}, {0, 5, 4}, {2, 3, 7}, {2, 7, 6},    // floor, long walls
+             {1, 2, 6}, {1, 6, 5}, {5, 6, 9}, {3, 0, 4}, {3, 4, 7}, {7, 4, 8},    // gable ends
+             {4, 5, 9}, {4, 9, 8}, {6, 7, 8}, {6, 8, 9}};                          // roof
+  return std::make_unique<MeshUdf>(m, "house");
+}
+
+// The ridge gets a chain of rank-2 seeds on it (gaps of 1.1-2 spacings measured; none wider than 2.5 asked),
+// only with the two-plane test (without it, the widest gap is over 4).
+TEST(OptimizeSeeds, AShallowCreaseGetsAChainOfCurveSeeds) {
+  const auto udf = HouseUdf();
+  const double top = 1.0 + std::tan(17.5 * M_PI / 180.0);
+  auto ridge = [&](const Vec3& p) { return std::hypot(p.y(), p.z() - top); };
+  for (double crease_angle : {30.0, 0.0}) {
+    OptimizeSeedsOptions options;
+    options.crease_angle_deg = crease_angle;
+    const SeedCloud out = OptimizeSeeds(*udf, Initial(*udf, 800, 2), options, Monitor::Null());
+    double spacing = 0.0;
+    NearestNeighbourCv(out.position, &spacing);
+    std::vector<double> along;  // x of the curve seeds on the ridge
+    for (size_t i = 0; i < out.size(); ++i)
+      if (out.rank[i] == 2 && ridge(out.position[i]) < 0.05 * spacing) along.push_back(out.position[i].x());
+    along.push_back(-1.0);
+    along.push_back(1.0);
+    std::sort(along.begin(), along.end());
+    double gap = 0.0;
+    for (size_t k = 1; k < along.size(); ++k) gap = std::max(gap, along[k] - along[k - 1]);
+    if (crease_angle > 0.0) {
+      EXPECT_LT(gap, 2.5 * spacing) << along.size() - 2 << " ridge seeds, spacing " << spacing << testing::PrintToString(along);
+    } else {
+      EXPECT_GT(gap, 4.0 * spacing) << "the paper's test alone found the 35° ridge: " << along.size() - 2;
+    }
+  }
+}
+
 // Curved features: with --feature-chord-tol, the chain of seeds on sphere-disc's equator (a circle of radius
 // 0.5, about 4.5 spacings at 200 seeds) follows it to within the tolerance: every chord between consecutive
 // equator seeds that is long enough to be split (2.5 × the feature clearance) has its midpoint within
@@ -750,6 +842,9 @@ TEST(OptimizeSeeds, BadOptionsAndInputs) {
   o = OptimizeSeedsOptions();
   o.sigma_min_spacing = 0.8;  // above the cap of 0.5
   EXPECT_THROW(o.Check(), UsageError);
+  o = OptimizeSeedsOptions();
+  o.crease_angle_deg = 90;
+  EXPECT_THROW(o.Check(), UsageError);
   const auto sphere = MakeShape("sphere");
   SeedCloud one;
   one.Resize(1);
@@ -847,7 +942,7 @@ TEST_F(OptimizeSeedsExe, HelpExplainsTheOptions) {
   const auto r = RunProgram("optimize-seeds", {"--help"});
   EXPECT_EQ(r.exit_code, 0);
   for (const char* flag : {"--udf", "--input", "--output", "--samples-per-cell", "--gamma", "--delta", "--trace",
-                           "--max-outer-iters", "--rank-threshold", "--seed", "--threads"})
+                           "--max-outer-iters", "--rank-threshold", "--crease-angle-deg", "--seed", "--threads"})
     EXPECT_NE(r.out.find(flag), std::string::npos) << flag;
 }
 

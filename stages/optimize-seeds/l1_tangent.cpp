@@ -3,6 +3,7 @@
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace voroudf {
 
@@ -293,6 +294,43 @@ void RecountRank(TangentRank& r, double tau, double spread) {
   r.rank = 0;
   for (int k = 0; k < 3; ++k)
     if (r.singular_values[k] > threshold) ++r.rank;
+}
+
+double SecondPlaneShare(double tau) { return tau * tau / (1.0 + tau * tau); }
+
+double BlindCreaseAngle(double tau) { return 2.0 * std::atan(tau); }
+
+bool SeesTwoPlanes(const Vec3* normals, size_t count, const TangentRank& r, double min_angle, double max_angle,
+                   double min_share, double min_contrast) {
+  const size_t min_group = static_cast<size_t>(std::ceil(min_share * static_cast<double>(count)));
+  if (count < 4 || min_group < 1 || 2 * min_group > count) return false;
+  // Axis angles in (−π/2, π/2] around the dominant direction v₁: a normal and its opposite are one plane.
+  std::vector<double> phi;
+  phi.reserve(count);
+  for (size_t m = 0; m < count; ++m) {
+    double a = normals[m].dot(r.v.col(0)), b = normals[m].dot(r.v.col(1));
+    if (a < 0.0) a = -a, b = -b;
+    if (a == 0.0 && b == 0.0) continue;
+    phi.push_back(std::atan2(b, a));
+  }
+  const size_t n = phi.size();
+  if (n < 2 * min_group) return false;
+  std::sort(phi.begin(), phi.end());
+  double sum = 0.0, sum_sq = 0.0;
+  for (double x : phi) sum += x, sum_sq += x * x;
+  // Prefix sums give each split's within-group sum of squares in O(1).
+  double best_sse = std::numeric_limits<double>::infinity(), best_gap = 0.0, left = 0.0, left_sq = 0.0;
+  for (size_t k = 1; k < n; ++k) {
+    left += phi[k - 1], left_sq += phi[k - 1] * phi[k - 1];
+    if (k < min_group || n - k < min_group) continue;
+    const double nl = static_cast<double>(k), nr = static_cast<double>(n - k);
+    const double right = sum - left;
+    const double sse = (left_sq - left * left / nl) + (sum_sq - left_sq - right * right / nr);
+    if (sse < best_sse) best_sse = sse, best_gap = right / nr - left / nl;
+  }
+  if (!std::isfinite(best_sse)) return false;
+  const double spread = std::sqrt(std::max(0.0, best_sse) / static_cast<double>(n));
+  return best_gap >= min_angle && best_gap < max_angle && best_gap >= min_contrast * spread;
 }
 
 }  // namespace voroudf

@@ -101,4 +101,25 @@ double UnexplainedNormalSpread(const std::vector<TangentRank>& ranks);
 /// spread = 0 is the paper's test.
 void RecountRank(TangentRank& r, double tau, double spread);
 
+/// The share of the samples that a second tangent plane turned by 90° needs for rank 2 at threshold τ:
+/// shares f and 1 − f of two orthogonal planes give s₂/s₁ = sqrt(f / (1 − f)), so f = τ² / (1 + τ²).
+double SecondPlaneShare(double tau);
+
+/// The crease angle below which the singular-value test at τ never counts a second plane: two equally
+/// sampled planes turned by θ give s₂/s₁ = tan(θ/2), the most any share gives, so θ < 2·atan(τ) (44° at 0.4).
+double BlindCreaseAngle(double tau);
+
+/// Crease test (not in the paper; docs/optimize-seeds.md, "Shallow creases"): whether the cell's normals
+/// show two tangent planes turned from each other by an angle in [min_angle, max_angle) (radians), each
+/// seen by at least `min_share` of the samples, rather than one curved sheet. It looks at the normals' axes
+/// in the plane of the first two singular vectors: the split of their sorted angles into two groups with
+/// the least within-group variance (1-D two-means, exact, each group at least min_share), which is a
+/// crease when the groups' mean angles differ by an angle in the range and by ≥ `min_contrast` × the
+/// within-group standard deviation. A uniform spread (a sheet curved by any angle) has contrast
+/// sqrt(12) = 3.46; two planes with the samples of a convex crease's wedge between them have more than 9.
+/// \param r the cell's TangentRank (v's first two columns are used)
+/// \pre 0 < min_share ≤ 0.5
+bool SeesTwoPlanes(const Vec3* normals, size_t count, const TangentRank& r, double min_angle, double max_angle,
+                   double min_share, double min_contrast);
+
 }  // namespace voroudf

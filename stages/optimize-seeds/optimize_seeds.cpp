@@ -26,6 +26,7 @@ void OptimizeSeedsOptions::Check() const {
   if (max_inner_iters < 1) throw UsageError("--max-inner-iters must be at least 1");
   if (lbfgs_max_iters < 1) throw UsageError("--lbfgs-max-iters must be at least 1");
   if (!(rank_threshold > 0.0 && rank_threshold < 1.0)) throw UsageError("--rank-threshold must be in (0, 1)");
+  if (!(crease_angle_deg >= 0.0 && crease_angle_deg < 90.0)) throw UsageError("--crease-angle-deg must be in [0, 90)");
   if (cell_knn < 1 || cell_knn > 64) throw UsageError("--cell-knn must be in [1, 64]");
   if (!(cell_radius_factor > 0.0 && cell_radius_factor <= 10.0)) throw UsageError("--cell-radius-factor must be in (0, 10]");
   if (!(max_step >= 0.0 && max_step <= 100.0)) throw UsageError("--max-step must be in [0, 100]");
@@ -172,6 +173,8 @@ size_t ThinCrowded(State& s, const std::vector<Vec3>& where, const std::vector<d
 
 // Rounds of RefineFeatureChords: each halves the chords it refines, so their misfit falls by 4 per round.
 constexpr int kFeatureChordRounds = 4;
+// SeesTwoPlanes' contrast: between a uniform spread's 3.46 (one curved sheet) and the > 9 of two planes.
+constexpr double kCreaseContrast = 6.0;
 
 class Optimizer {
  public:
@@ -291,6 +294,12 @@ class Optimizer {
     for (long i = 0; i < n; ++i) {
       TangentRank& r = ranks[static_cast<size_t>(i)];
       RecountRank(r, options_.rank_threshold, normal_spread_);
+      if (r.rank == 1 && crease_angle_ > 0.0 &&
+          SeesTwoPlanes(cells.gradient.data() + cells.sample_offset[i],
+                        cells.sample_offset[i + 1] - cells.sample_offset[i], r, crease_angle_,
+                        BlindCreaseAngle(options_.rank_threshold), SecondPlaneShare(options_.rank_threshold),
+                        kCreaseContrast))
+        r.rank = 2;
       MoveSpace& space = s.space[i];
       if (r.rank == 0) {
         // No usable sample (an empty cell within the budget): move in the tangent plane of the seed's own
@@ -581,6 +590,7 @@ class Optimizer {
   std::vector<Vec3> cached_positions_;
   size_t last_short_cells_ = 0;
   double last_acceptance_ = 0.0;
+  double crease_angle_ = options_.crease_angle_deg * M_PI / 180.0;  // radians
   double normal_spread_ = 0.0;  ///< the last Analyze's UnexplainedNormalSpread (0 with --rank-noise off)
 };
 

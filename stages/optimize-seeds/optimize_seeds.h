@@ -32,6 +32,9 @@ struct OptimizeSeedsOptions {
   int max_inner_iters = 10;       ///< cap on Alg. 1's inner loop (--max-inner-iters)
   int lbfgs_max_iters = 50;       ///< L-BFGS iterations per inner round (Ceres' default) (--lbfgs-max-iters)
   double rank_threshold = 0.4;    ///< τ: rank(A) = #{singular values > τ·s_1} (--rank-threshold)
+  /// A rank-1 cell whose normals show two planes turned by at least this many degrees, each seen by the share
+  /// of samples τ asks of a second plane at 90°, is rank 2 (SeesTwoPlanes; --crease-angle-deg; 0: the paper's test alone)
+  double crease_angle_deg = 30.0;
   /// --rank-noise: the rank test counts s_k > sqrt(τ² + ν²)·s_1, ν the median s_3/s_1 over the cells (the normal
   /// spread no surface explains: gradient errors), so that a noisy sheet is not a crease; off (default): the
   /// paper's test. Off by default: on feature-dense parts the median s_3/s_1 is geometry, not noise (docs).
