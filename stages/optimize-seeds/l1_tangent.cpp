@@ -304,8 +304,17 @@ bool SeesTwoPlanes(const Vec3* normals, size_t count, const TangentRank& r, doub
                    double min_share, double min_contrast) {
   const size_t min_group = static_cast<size_t>(std::ceil(min_share * static_cast<double>(count)));
   if (count < 4 || min_group < 1 || 2 * min_group > count) return false;
+  // Early out for most sheet cells. A share f of the normals turned by θ from the rest makes
+  // (s₂² + s₃²)/s₁² ≥ μ₂/μ₁, μ = (1 ± √(1 − 4f(1−f)sin²θ))/2 the two-point spread (a normal is at least as far
+  // from v₁ as its axis angle says, and spread within a group adds), and s₂ ≥ s₃: so a cell with
+  // s₂²/s₁² below half that, at the smallest f and θ allowed, has no qualifying split.
+  const double p = min_share * (1.0 - min_share) * std::pow(std::sin(min_angle), 2);
+  const double root = std::sqrt(std::max(0.0, 1.0 - 4.0 * p));
+  const double s1 = r.singular_values[0], s2 = r.singular_values[1];
+  if (2.0 * s2 * s2 * (1.0 + root) < (1.0 - root) * s1 * s1) return false;
   // Axis angles in (−π/2, π/2] around the dominant direction v₁: a normal and its opposite are one plane.
-  std::vector<double> phi;
+  thread_local std::vector<double> phi;
+  phi.clear();
   phi.reserve(count);
   for (size_t m = 0; m < count; ++m) {
     double a = normals[m].dot(r.v.col(0)), b = normals[m].dot(r.v.col(1));
