@@ -843,8 +843,12 @@ TEST(OptimizeSeeds, BadOptionsAndInputs) {
   o.sigma_min_spacing = 0.8;  // above the cap of 0.5
   EXPECT_THROW(o.Check(), UsageError);
   o = OptimizeSeedsOptions();
-  o.crease_angle_deg = 90;
+  o.crease_angle_deg = 45;  // at or above 2 atan(0.4) = 43.6 degrees the two-plane test would never fire
   EXPECT_THROW(o.Check(), UsageError);
+  o.crease_angle_deg = -1;
+  EXPECT_THROW(o.Check(), UsageError);
+  o.crease_angle_deg = 43;
+  EXPECT_NO_THROW(o.Check());
   const auto sphere = MakeShape("sphere");
   SeedCloud one;
   one.Resize(1);

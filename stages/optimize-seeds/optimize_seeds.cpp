@@ -26,7 +26,12 @@ void OptimizeSeedsOptions::Check() const {
   if (max_inner_iters < 1) throw UsageError("--max-inner-iters must be at least 1");
   if (lbfgs_max_iters < 1) throw UsageError("--lbfgs-max-iters must be at least 1");
   if (!(rank_threshold > 0.0 && rank_threshold < 1.0)) throw UsageError("--rank-threshold must be in (0, 1)");
-  if (!(crease_angle_deg >= 0.0 && crease_angle_deg < 90.0)) throw UsageError("--crease-angle-deg must be in [0, 90)");
+  if (!(crease_angle_deg >= 0.0 && crease_angle_deg * M_PI / 180.0 < BlindCreaseAngle(rank_threshold))) {
+    char limit[32];
+    std::snprintf(limit, sizeof limit, "%.1f", BlindCreaseAngle(rank_threshold) * 180.0 / M_PI);
+    throw UsageError(std::string("--crease-angle-deg must be in [0, ") + limit +
+                     "): from 2 atan(--rank-threshold) degrees on, the rank test sees a crease itself");
+  }
   if (cell_knn < 1 || cell_knn > 64) throw UsageError("--cell-knn must be in [1, 64]");
   if (!(cell_radius_factor > 0.0 && cell_radius_factor <= 10.0)) throw UsageError("--cell-radius-factor must be in (0, 10]");
   if (!(max_step >= 0.0 && max_step <= 100.0)) throw UsageError("--max-step must be in [0, 100]");
