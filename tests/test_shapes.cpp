@@ -37,6 +37,16 @@ double HemisphereD(const Vec3& p) {
 double TorusD(const Vec3& p) { return std::abs(std::hypot(std::hypot(p.x(), p.y()) - 0.35, p.z()) - 0.15); }
 double RingD(const Vec3& p) { return std::abs(std::hypot(std::hypot(p.x(), p.y()) - 0.48, p.z()) - 0.03); }
 
+// shape:fold: the half square x in [-0.5, 0] of z = 0, and its mirror image turned up by 35° about the y axis
+// (in coordinates along the turned half, u = x cos + z sin, w = -x sin + z cos).
+double FoldD(const Vec3& p) {
+  const double c = std::cos(35.0 * M_PI / 180.0), s = std::sin(35.0 * M_PI / 180.0);
+  auto half = [](double u, double y, double w) {  // distance to [-0.5, 0] x [-0.5, 0.5] in the plane w = 0
+    return std::sqrt(w * w + std::pow(std::max({u, -0.5 - u, 0.0}), 2) + std::pow(std::max(std::abs(y) - 0.5, 0.0), 2));
+  };
+  return std::min(half(p.x(), p.y(), p.z()), half(-(p.x() * c + p.z() * s), p.y(), -p.x() * s + p.z() * c));
+}
+
 struct Case {
   const char* name;
   std::function<double(const Vec3&)> exact;
@@ -55,6 +65,7 @@ const std::vector<Case>& Cases() {
       {"three-discs", [](const Vec3& p) { return std::min({DiscZ(p), DiscX(p), DiscY(p)}); }},
       {"torus", TorusD},
       {"sphere-ring", [](const Vec3& p) { return std::min(std::abs(p.norm() - 0.35), RingD(p)); }},
+      {"fold", FoldD},
   };
   return cases;
 }
