@@ -676,8 +676,9 @@ TEST(OptimizeSeeds, SphereWithDiscRankTwoSeedsOnTheEquator) {
 
 // A closed "house": the box [-1,1]² × [0,1] with a roof whose two faces rise 17.5° each way to a ridge along
 // x, so the ridge turns by 35° — below the 44° the singular-value test can see — and the eaves by 72.5°.
+const double kHouseRidge = 1.0 + std::tan(17.5 * M_PI / 180.0);  // the ridge's height
 std::unique_ptr<MeshUdf> HouseUdf() {
-  const double ridge = 1.0 + std::tan(17.5 * M_PI / 180.0);
+  const double ridge = kHouseRidge;
   TriangleMesh m;
   m.vertices = {Vec3(-1, -1, 0), Vec3(1, -1, 0), Vec3(1, 1, 0), Vec3(-1, 1, 0),   // floor
                 Vec3(-1, -1, 1), Vec3(1, -1, 1), Vec3(1, 1, 1), Vec3(-1, 1, 1),   // eaves
@@ -692,8 +693,7 @@ std::unique_ptr<MeshUdf> HouseUdf() {
 // only with the two-plane test (without it, the widest gap is over 4).
 TEST(OptimizeSeeds, AShallowCreaseGetsAChainOfCurveSeeds) {
   const auto udf = HouseUdf();
-  const double top = 1.0 + std::tan(17.5 * M_PI / 180.0);
-  auto ridge = [&](const Vec3& p) { return std::hypot(p.y(), p.z() - top); };
+  auto ridge = [](const Vec3& p) { return std::hypot(p.y(), p.z() - kHouseRidge); };
   for (double crease_angle : {30.0, 0.0}) {
     OptimizeSeedsOptions options;
     options.crease_angle_deg = crease_angle;

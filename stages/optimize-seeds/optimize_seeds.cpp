@@ -301,9 +301,8 @@ class Optimizer {
       RecountRank(r, options_.rank_threshold, normal_spread_);
       if (r.rank == 1 && crease_angle_ > 0.0 &&
           SeesTwoPlanes(cells.gradient.data() + cells.sample_offset[i],
-                        cells.sample_offset[i + 1] - cells.sample_offset[i], r, crease_angle_,
-                        BlindCreaseAngle(options_.rank_threshold), SecondPlaneShare(options_.rank_threshold),
-                        kCreaseContrast))
+                        cells.sample_offset[i + 1] - cells.sample_offset[i], r, crease_angle_, crease_max_angle_,
+                        crease_share_, kCreaseContrast))
         r.rank = 2;
       MoveSpace& space = s.space[i];
       if (r.rank == 0) {
@@ -595,7 +594,10 @@ class Optimizer {
   std::vector<Vec3> cached_positions_;
   size_t last_short_cells_ = 0;
   double last_acceptance_ = 0.0;
-  double crease_angle_ = options_.crease_angle_deg * M_PI / 180.0;  // radians
+  // SeesTwoPlanes' bounds, fixed by the options: the angle range (radians) and each plane's share.
+  double crease_angle_ = options_.crease_angle_deg * M_PI / 180.0;
+  double crease_max_angle_ = BlindCreaseAngle(options_.rank_threshold);
+  double crease_share_ = SecondPlaneShare(options_.rank_threshold);
   double normal_spread_ = 0.0;  ///< the last Analyze's UnexplainedNormalSpread (0 with --rank-noise off)
 };
 
