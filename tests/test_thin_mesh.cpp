@@ -271,6 +271,44 @@ TEST(ThinMesh, AFaceOverACrackAtABranchingLineIsSplit) {
   ExpectGridWithWholeFin(out);
 }
 
+TEST(ThinMesh, AFlapLeftDanglingByANotchIsCollapsedKeepingChi) {
+  const auto udf = MakeShape("disc");
+  TriangleMesh m;
+  AddGrid(m, 6, 12);  // vertex (i, j) is j * 7 + i
+  // A vertical fin on column 3 (x = 0), 24 faces: its base edges branch. The grid face (2,5)-(3,6)-(2,6)
+  // is missing and in its place the dual put a flap (2,5)-(3,6)-top(3,6): on the diagonal, leaning on the
+  // fin's edge above (3,6), with a free edge (2,5)-top(3,6). Step 4 closes the notch at (2,6); the diagonal
+  // then has 3 faces and the flap hangs from its free edge. Step 5 removes it: the mesh is the grid with
+  // the fin.
+  std::vector<int> top(13);
+  for (int j = 0; j <= 12; ++j) top[static_cast<size_t>(j)] = AddVertex(m, {0.0, -0.3 + 0.1 * j, 0.1});
+  for (int j = 0; j < 12; ++j) {
+    m.faces.push_back({j * 7 + 3, (j + 1) * 7 + 3, top[static_cast<size_t>(j + 1)]});
+    m.faces.push_back({j * 7 + 3, top[static_cast<size_t>(j + 1)], top[static_cast<size_t>(j)]});
+  }
+  const int v25 = 37, v36 = 45, v26 = 44;
+  m.faces.erase(std::find(m.faces.begin(), m.faces.end(), Tri{v25, v36, v26}));
+  m.faces.push_back({v25, v36, top[6]});
+  ThinMeshStats stats;
+  const TriangleMesh out = ThinMesh(*udf, m, ThinMeshOptions{}, Monitor::Null(), &stats);
+  EXPECT_EQ(stats.holes_closed, 1u);
+  EXPECT_EQ(stats.flap_faces_removed, 1u);
+  EXPECT_TRUE(SortedFaces(out).count({v25, v26, v36}));
+  const TopologyStats topo = ComputeTopology(out);
+  EXPECT_EQ(out.faces.size(), 144u + 24u);
+  EXPECT_EQ(topo.nonmanifold_edges, 12u);      // the fin's base
+  EXPECT_EQ(topo.boundary_edges, 36u + 14u);   // the grid's outline and the fin's three free sides
+  EXPECT_EQ(topo.euler, 1);  // the grid, a disc, with a disc (the fin) glued to it along a line
+
+  // With --thinning paper neither step runs: the flap stays, one more branching edge, and the notch stays
+  // open.
+  ThinMeshOptions paper;
+  paper.thinning = "paper";
+  const TopologyStats p = ComputeTopology(ThinMesh(*udf, m, paper, Monitor::Null()));
+  EXPECT_EQ(p.nonmanifold_edges, 13u);
+  EXPECT_EQ(p.boundary_edges, 36u + 14u + 3u);
+}
+
 TEST(ThinMesh, ManifoldComponentsAreOrientedConsistently) {
   const auto udf = MakeShape("disc");
   TriangleMesh m;

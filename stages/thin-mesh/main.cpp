@@ -23,7 +23,8 @@ int main(int argc, char** argv) {
   app.add_option("--degenerate-quality", options.degenerate_quality,
                  "faces with triangle quality below this are dropped as degenerate (0: only zero area)");
   app.add_option("--thinning", options.thinning,
-                 "paper: the paper's two steps only; close-holes: then close the junction gaps the dual left")
+                 "paper: the paper's two steps only; close-holes: then close the junction gaps the dual left and "
+                 "collapse the flaps that leaves dangling")
       ->check(CLI::IsMember({"paper", "close-holes"}));
   app.add_option("--overlap-angle", options.overlap_angle_deg,
                  "a face added to close a gap must not lie within this angle (deg) of a face on its edges");

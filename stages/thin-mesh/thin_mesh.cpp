@@ -43,6 +43,10 @@ class Thinner {
     face_edges_.resize(faces_.size());
     for (size_t f = 0; f < faces_.size(); ++f) {
       const Tri& t = faces_[f];
+      for (int v : t) {
+        if (static_cast<size_t>(v) >= vertex_faces_.size()) vertex_faces_.resize(static_cast<size_t>(v) + 1, 0);
+        ++vertex_faces_[static_cast<size_t>(v)];
+      }
       face_edges_[f] = {incidence_.Find(t[0], t[1]), incidence_.Find(t[1], t[2]), incidence_.Find(t[2], t[0])};
       by_vertices_.emplace(Sorted(t), static_cast<int>(f));
     }
@@ -180,15 +184,30 @@ class Thinner {
   }
 
   /// Removes `comp` unless that would leave one of its border edges with a single face (a new hole).
-  bool RemoveComponentIfSafe(const std::vector<int>& comp) {
+  /// Removes the faces of `comp` unless that would leave one of its border edges with a single face. With
+  /// `collapse_only`, also unless the component hangs from a free (boundary) edge and its removal keeps the
+  /// Euler characteristic: a dangling flap collapsed from its free edge, which changes no topology.
+  bool RemoveComponentIfSafe(const std::vector<int>& comp, bool collapse_only) {
     std::unordered_map<int, int> uses;  // edge -> faces of comp on it
+    std::unordered_map<int, int> corner_uses;  // vertex -> faces of comp on it
     for (int f : comp) {
       if (!alive_[static_cast<size_t>(f)]) return false;
       for (int e : face_edges_[static_cast<size_t>(f)]) ++uses[e];
+      for (int v : faces_[static_cast<size_t>(f)]) ++corner_uses[v];
     }
+    bool free_edge = false;
+    long edges_gone = 0;
     for (const auto& [e, c] : uses) {
       const int v = valence_[static_cast<size_t>(e)];
       if (c < v && v - c < 2) return false;
+      free_edge = free_edge || v == 1;
+      edges_gone += c == v;
+    }
+    if (collapse_only) {
+      long vertices_gone = 0;
+      for (const auto& [v, c] : corner_uses) vertices_gone += c == vertex_faces_[static_cast<size_t>(v)];
+      // chi = V - E + F changes by -(vertices_gone - edges_gone + faces)
+      if (!free_edge || vertices_gone - edges_gone + static_cast<long>(comp.size()) != 0) return false;
     }
     for (int f : comp) Remove(f);
     return true;
@@ -240,6 +259,7 @@ class Thinner {
   void Remove(int f) {
     alive_[static_cast<size_t>(f)] = 0;
     for (int e : face_edges_[static_cast<size_t>(f)]) --valence_[static_cast<size_t>(e)];
+    for (int v : faces_[static_cast<size_t>(f)]) --vertex_faces_[static_cast<size_t>(v)];
   }
 
   std::vector<Tri> faces_;
@@ -247,6 +267,7 @@ class Thinner {
   std::vector<char> alive_;
   EdgeFaces incidence_;
   std::vector<int> valence_;  ///< present faces per edge
+  std::vector<int> vertex_faces_;  ///< present faces per vertex
   std::vector<std::array<int, 3>> face_edges_;
   std::unordered_map<Tri, int, TriHash> by_vertices_;
 };
@@ -291,6 +312,36 @@ std::vector<Tri> CleanFaces(const TriangleMesh& thick, double min_quality, ThinM
   return faces;
 }
 
+// Step 2's pass: small components, farthest from the surface first, until none can go; with
+// `collapse_only` only those whose removal is a collapse from a free edge (RemoveComponentIfSafe). Returns
+// the faces removed.
+size_t RemoveSmallComponents(Thinner& thinner, size_t min_faces, bool collapse_only, const std::string& what,
+                             ThinMeshStats& st, Monitor& monitor) {
+  size_t removed_faces = 0;
+  for (;;) {
+    const auto comps = thinner.ManifoldComponents(min_faces);
+    size_t removed = 0, faces = 0, small = 0;
+    for (const auto& comp : comps) {
+      if (comp.size() >= min_faces) break;
+      ++small;
+      if (thinner.RemoveComponentIfSafe(comp, collapse_only)) {
+        ++removed;
+        faces += comp.size();
+      }
+    }
+    removed_faces += faces;
+    if (!collapse_only) {
+      st.components_removed += removed;
+      st.component_faces_removed += faces;
+      st.small_components_left = small - removed;
+    }
+    if (small > 0)
+      monitor.Info(what + Count(small, "components under ") + std::to_string(min_faces) + " faces, " +
+                   Count(removed, "removed (") + Count(faces, "faces)"));
+    if (removed == 0) return removed_faces;
+  }
+}
+
 // Steps 1-3 (paper Sec. 3.4): tetrahedra, then small components, until neither changes anything.
 void PaperThinning(Thinner& thinner, const ThinMeshOptions& options, ThinMeshStats& st, Monitor& monitor) {
   for (;;) {
@@ -310,27 +361,8 @@ void PaperThinning(Thinner& thinner, const ThinMeshOptions& options, ThinMeshSta
       changed = true;
     }
     // 2. Small components, farthest from the surface first, until none can go.
-    for (;;) {
-      const auto comps = thinner.ManifoldComponents(options.min_component_faces);
-      size_t removed = 0, removed_faces = 0, small = 0;
-      for (const auto& comp : comps) {
-        if (comp.size() >= options.min_component_faces) break;
-        ++small;
-        if (thinner.RemoveComponentIfSafe(comp)) {
-          ++removed;
-          removed_faces += comp.size();
-        }
-      }
-      st.components_removed += removed;
-      st.component_faces_removed += removed_faces;
-      st.small_components_left = small - removed;
-      if (small > 0)
-        monitor.Info("round " + std::to_string(st.rounds) + ": " + Count(small, "components under ") +
-                     std::to_string(options.min_component_faces) + " faces, " + Count(removed, "removed (") +
-                     Count(removed_faces, "faces)"));
-      if (removed == 0) break;
-      changed = true;
-    }
+    const std::string round = "round " + std::to_string(st.rounds) + ": ";
+    if (RemoveSmallComponents(thinner, options.min_component_faces, false, round, st, monitor) > 0) changed = true;
     if (!changed) break;
   }
   st.tetrahedra_left = thinner.Tetrahedra().size();
@@ -338,6 +370,26 @@ void PaperThinning(Thinner& thinner, const ThinMeshOptions& options, ThinMeshSta
     monitor.Warn(Count(st.tetrahedra_left, "closed tetrahedra are left: none of their face pairs shares a manifold edge"));
   if (st.small_components_left > 0)
     monitor.Warn(Count(st.small_components_left, "small components are left: removing them would open a hole"));
+}
+
+// A Thinner over `faces`, with their centroids' UDF values (the order of removals).
+Thinner MakeThinner(const Udf& udf, const std::vector<Vec3>& vertices, std::vector<Tri> faces) {
+  std::vector<Vec3> centroid(faces.size());
+  for (size_t f = 0; f < faces.size(); ++f)
+    centroid[f] = (vertices[static_cast<size_t>(faces[f][0])] + vertices[static_cast<size_t>(faces[f][1])] +
+                   vertices[static_cast<size_t>(faces[f][2])]) /
+                  3.0;
+  std::vector<double> centroid_udf;
+  std::vector<Vec3> centroid_grad;
+  udf.Evaluate(centroid, centroid_udf, centroid_grad);
+  return Thinner(std::move(faces), std::move(centroid_udf));
+}
+
+std::vector<Tri> AliveFaces(const Thinner& thinner) {
+  std::vector<Tri> kept;
+  for (size_t f = 0; f < thinner.faces().size(); ++f)
+    if (thinner.alive()[f]) kept.push_back(thinner.faces()[f]);
+  return kept;
 }
 
 }  // namespace
@@ -349,27 +401,24 @@ TriangleMesh ThinMesh(const Udf& udf, const TriangleMesh& thick, const ThinMeshO
   std::vector<Tri> faces = CleanFaces(thick, options.degenerate_quality, st);
   monitor.Info(Count(thick.faces.size(), "faces in; dropped ") + Count(st.degenerate_faces, "degenerate and ") +
                Count(st.duplicate_faces, "duplicate faces"));
-  std::vector<Vec3> centroid(faces.size());
-  for (size_t f = 0; f < faces.size(); ++f)
-    centroid[f] = (thick.vertices[static_cast<size_t>(faces[f][0])] + thick.vertices[static_cast<size_t>(faces[f][1])] +
-                   thick.vertices[static_cast<size_t>(faces[f][2])]) /
-                  3.0;
-  std::vector<double> centroid_udf;
-  std::vector<Vec3> centroid_grad;
-  udf.Evaluate(centroid, centroid_udf, centroid_grad);
-
-  Thinner thinner(std::move(faces), std::move(centroid_udf));
+  Thinner thinner = MakeThinner(udf, thick.vertices, std::move(faces));
   PaperThinning(thinner, options, st, monitor);
-  std::vector<Tri> kept;
-  for (size_t f = 0; f < thinner.faces().size(); ++f)
-    if (thinner.alive()[f]) kept.push_back(thinner.faces()[f]);
-  // 4. Junction gaps: cracks (T-junctions), then triangular holes and notches (close_holes.h).
+  std::vector<Tri> kept = AliveFaces(thinner);
   if (options.thinning != "paper") {
+    // 4. Junction gaps: cracks (T-junctions), then triangular holes and notches (close_holes.h).
     const double min_cos = std::cos(options.overlap_angle_deg * M_PI / 180.0);
     st.cracks_split = SplitFacesOverCracks(thick.vertices, kept, options.degenerate_quality, min_cos, 0.1);
     st.holes_closed = CloseTriangularHoles(thick.vertices, kept, options.degenerate_quality, min_cos);
     monitor.Info(Count(st.cracks_split, "faces split over a crack (T-junction), ") +
                  Count(st.holes_closed, "triangular holes and notches closed"));
+    // 5. Dangling flaps: a face step 4 gives a junction can leave the face the dual put there hanging from
+    // a free edge, with its other edges now shared by 3 faces. Removing such a flap is a collapse: it
+    // changes neither chi nor any other edge's count below 2.
+    if (st.cracks_split + st.holes_closed > 0) {
+      Thinner flaps = MakeThinner(udf, thick.vertices, std::move(kept));
+      st.flap_faces_removed = RemoveSmallComponents(flaps, options.min_component_faces, true, "dangling flaps: ", st, monitor);
+      kept = AliveFaces(flaps);
+    }
   }
   Thinner oriented(std::move(kept), std::vector<double>());
   oriented.OrientComponents();
