@@ -122,6 +122,67 @@ TEST(BuildGvd, TheGraphDoesNotJumpBetweenSheetsAwayFromTheirIntersection) {
   EXPECT_GT(across, 0u) << "the sheets must connect across the non-manifold line";
 }
 
+// Seeds on crossing-planes at spacing h: a row on the line x = z = 0 (rank 2), a grid on each of the four
+// half-planes from `gap` away from the line (rank 1, the plane's normal).
+SeedCloud CrossingSeeds(double h, double gap) {
+  SeedCloud s;
+  auto add = [&](const Vec3& p, const Vec3& n, uint8_t rank) {
+    s.position.push_back(p);
+    s.normal.push_back(n);
+    s.udf.push_back(0.0);
+    s.rank.push_back(rank);
+  };
+  for (double y = -0.45; y < 0.46; y += h) {
+    add({0.0, y, 0.0}, {0.0, 0.0, 1.0}, kRankEdge);
+    for (double t = gap; t < 0.46; t += h)
+      for (double sign : {-1.0, 1.0}) {
+        add({sign * t, y, 0.0}, {0.0, 0.0, 1.0}, kRankSheet);
+        add({0.0, y, sign * t}, {1.0, 0.0, 0.0}, kRankSheet);
+      }
+  }
+  return s;
+}
+
+// Samples on the plane z = 0 within 0.2 h of the crossing line, per unit width, over those 1-2 h from it
+// (away from the squares' rims).
+double DensityAtTheCrossing(const GvdResult& r, double h) {
+  double near = 0.0, far = 0.0;
+  for (const Vec3& p : r.samples.position) {
+    if (std::abs(p.z()) > 1e-9 || std::abs(p.y()) > 0.3) continue;
+    const double x = std::abs(p.x());
+    if (x > 1e-9 && x < 0.2 * h) near += 1.0;
+    if (x > 1.0 * h && x < 2.0 * h) far += 1.0;
+  }
+  return (near / (0.2 * h)) / (far / h);
+}
+
+TEST(BuildGvd, CurveSeedsSampleEverySheetEvenlyUpToTheCrossing) {
+  // A ball around a seed on the line projects onto the nearer plane: each of the four half-planes gets a
+  // 90-degree wedge, whose points land ever sparser towards the line. Drawn again in their tangent planes,
+  // they cover each plane evenly up to the line, where the Voronoi vertices of the line's seeds are. The
+  // sheet seeds start 4 spacings away, so that within 2 spacings of the line the samples are the line
+  // seeds' (their balls reach 3 spacings: the 6th-nearest seed is 3 along the line).
+  const auto udf = MakeShape("crossing-planes");
+  const double h = 0.05;
+  const SeedCloud seeds = CrossingSeeds(h, 4.0 * h);
+  BuildGvdOptions ball;
+  ball.curve_samples = "ball";
+  const GvdResult with_ball = BuildGvd(*udf, seeds, ball, false, Monitor::Null());
+  const GvdResult tangent = BuildGvd(*udf, seeds, BuildGvdOptions{}, false, Monitor::Null());
+  EXPECT_EQ(with_ball.stats.samples_redrawn, 0u);
+  EXPECT_GT(tangent.stats.samples_redrawn, 0u);
+  const double ball_density = DensityAtTheCrossing(with_ball, h), tangent_density = DensityAtTheCrossing(tangent, h);
+  EXPECT_LT(ball_density, 0.5) << "the ball's wedges thin out at the line";
+  EXPECT_GT(tangent_density, 0.85) << "as dense at the line as 1-2 spacings away";
+  EXPECT_LT(tangent_density, 1.5);
+  // Every redrawn sample is on the surface, within the projection's tolerance.
+  std::vector<double> d;
+  std::vector<Vec3> g;
+  udf->Evaluate(tangent.samples.position, d, g);
+  const double tol = 1.01 * BuildGvdOptions{}.proj_tol_rel * udf->Domain().Diagonal();
+  for (double v : d) ASSERT_LT(v, tol);
+}
+
 TEST(BuildGvd, OverPrunedGraphsLeaveUnreachedSamplesCounted) {
   const auto udf = MakeShape("sphere");
   const SeedCloud seeds = Seeds(*udf, 100);

@@ -5,6 +5,7 @@
 #include <Eigen/Eigenvalues>
 
 #include <algorithm>
+#include <array>
 #include <cstdarg>
 #include <limits>
 #include <cmath>
@@ -76,13 +77,23 @@ void BuildGvdOptions::Check() const {
   if (knn < 3 || knn > 200) throw UsageError("--knn must be in [3, 200]");
   if (!(eps_udf_rel > 0.0 && eps_udf_rel < 1.0)) throw UsageError("--eps-udf-rel must be in (0, 1)");
   if (!(eps_grad > 0.0 && eps_grad <= 1.0)) throw UsageError("--eps-grad must be in (0, 1]");
+  if (curve_samples != "tangent" && curve_samples != "ball") throw UsageError("--curve-samples must be tangent or ball");
   CheckRelativeProjection(proj_tol_rel, proj_floor_rel, proj_max_iters);
 }
 
 namespace {
 
+// What step 1b needs of each ball sample (index i - in_space): its seed, and a point of the unit disc drawn
+// from the sample's own stream; and each seed's ball radius.
+struct TangentDraws {
+  std::vector<int> owner;
+  std::vector<std::array<double, 2>> disc;
+  std::vector<double> radius;
+};
+
 // Step 1: the dense samples before projection, the first `*in_space` of them uniform in the box.
-std::vector<Vec3> DrawSamples(const SeedCloud& seeds, const Box& box, const BuildGvdOptions& options, size_t* in_space_out) {
+std::vector<Vec3> DrawSamples(const SeedCloud& seeds, const Box& box, const BuildGvdOptions& options, size_t* in_space_out,
+                              TangentDraws* tangent_out) {
   const size_t num_seeds = seeds.size();
   const double diag = box.Diagonal();
   // Ball radius per seed: the distance to its 6th-nearest seed (one ring of neighbours
@@ -111,6 +122,9 @@ std::vector<Vec3> DrawSamples(const SeedCloud& seeds, const Box& box, const Buil
     }
     ball_end[num_seeds - 1] = total - in_space;
   }
+  TangentDraws tangent;
+  tangent.owner.resize(total - in_space);
+  tangent.disc.resize(total - in_space);
   std::vector<Vec3> samples(total);
 #pragma omp parallel for schedule(static)
   for (long li = 0; li < static_cast<long>(total); ++li) {
@@ -126,9 +140,68 @@ std::vector<Vec3> DrawSamples(const SeedCloud& seeds, const Box& box, const Buil
       for (int c = 0; c < 3; ++c) u[c] = rng.Uniform(-1.0, 1.0);
     } while (u.squaredNorm() > 1.0);
     samples[i] = seeds.position[s] + radius[s] * u;
+    double a, b;
+    do {
+      a = rng.Uniform(-1.0, 1.0);
+      b = rng.Uniform(-1.0, 1.0);
+    } while (a * a + b * b > 1.0);
+    tangent.disc[i - in_space] = {a, b};
+    tangent.owner[i - in_space] = static_cast<int>(s);
   }
+  tangent.radius = std::move(radius);
   *in_space_out = in_space;
+  *tangent_out = std::move(tangent);
   return samples;
+}
+
+// Step 1b (--curve-samples tangent): the ball samples of the seeds on curves and corners (rank 2 and 3 in
+// the seeds file) are drawn again, each in the disc of its ball's radius in the tangent plane where it
+// landed, around its seed's foot on that plane, and projected again. A ball's points project onto the
+// nearest sheet, so where sheets cross or meet at a concave crease each gets a wedge's points only and the
+// density on it falls to zero at the curve (three-discs, 5k seeds: 17 % of the mean within 0.2 spacings of
+// an axis), right where the curve's Voronoi vertices lie. Redrawn, each sheet keeps its share of the ball's
+// samples and gets them evenly up to the curve. A redrawn point whose projection fails, or that lands where
+// the normal is not the first landing point's (another sheet, a crease or a rim: a wedge point's gradient
+// is not a sheet normal), is not used: the first landing point stays, so creases and rims keep the ball's
+// wedge samples. Returns how many were replaced.
+size_t RedrawInTangentDiscs(const Udf& udf, const SeedCloud& seeds, const TangentDraws& tangent, size_t in_space,
+                            const ProjectionOptions& proj, std::vector<Vec3>& samples, ProjectionResult& projected,
+                            Monitor& monitor) {
+  const size_t count = tangent.owner.size();
+  std::vector<size_t> which;
+  which.reserve(count);
+  for (size_t k = 0; k < count; ++k)
+    if (projected.converged[in_space + k] && projected.gradient[in_space + k].norm() > 0.5 &&
+        seeds.rank[static_cast<size_t>(tangent.owner[k])] >= kRankEdge)
+      which.push_back(k);
+  std::vector<Vec3> redrawn(which.size());
+#pragma omp parallel for schedule(static)
+  for (long lj = 0; lj < static_cast<long>(which.size()); ++lj) {
+    const size_t k = which[static_cast<size_t>(lj)], i = in_space + k;
+    const Vec3 n = projected.gradient[i].normalized();
+    const Vec3& seed = seeds.position[static_cast<size_t>(tangent.owner[k])];
+    const Vec3 centre = seed - (seed - samples[i]).dot(n) * n;
+    const Vec3 t1 = n.unitOrthogonal(), t2 = n.cross(t1);
+    const double r = tangent.radius[static_cast<size_t>(tangent.owner[k])];
+    redrawn[static_cast<size_t>(lj)] = centre + r * (tangent.disc[k][0] * t1 + tangent.disc[k][1] * t2);
+  }
+  const ProjectionResult again = ProjectToZeroSet(udf, redrawn, proj, monitor);
+  const double same_sheet = std::cos(25.0 * M_PI / 180.0);
+  size_t replaced = 0;
+  for (size_t j = 0; j < which.size(); ++j) {
+    if (!again.converged[j]) continue;
+    const size_t i = in_space + which[j];
+    if (std::abs(again.gradient[j].dot(projected.gradient[i])) <
+        same_sheet * again.gradient[j].norm() * projected.gradient[i].norm())
+      continue;
+    samples[i] = redrawn[j];
+    projected.distance[i] = again.distance[j];
+    projected.gradient[i] = again.gradient[j];
+    ++replaced;
+  }
+  monitor.Info(Format("%zu samples around curve and corner seeds drawn again in their tangent planes, %zu of them kept",
+                      which.size(), replaced));
+  return replaced;
 }
 
 // Step 2: the graph nodes, seeds first (so that they win Morton-cell ties), then converged samples, sorted
@@ -413,12 +486,15 @@ GvdResult BuildGvd(const Udf& udf, const SeedCloud& seeds, const BuildGvdOptions
 
   // 1. Dense samples, projected onto the zero set.
   size_t in_space = 0;
-  std::vector<Vec3> samples = DrawSamples(seeds, box, options, &in_space);
+  TangentDraws tangent;
+  std::vector<Vec3> samples = DrawSamples(seeds, box, options, &in_space, &tangent);
   const size_t total = samples.size();
   stats.samples_drawn = total;
   const ProjectionOptions proj = RelativeProjection(diag, options.proj_tol_rel, options.proj_floor_rel, options.proj_max_iters);
-  const ProjectionResult projected = ProjectToZeroSet(udf, samples, proj, monitor);
+  ProjectionResult projected = ProjectToZeroSet(udf, samples, proj, monitor);
   stats.samples_projected = projected.num_converged;
+  if (options.curve_samples == "tangent")
+    stats.samples_redrawn = RedrawInTangentDiscs(udf, seeds, tangent, in_space, proj, samples, projected, monitor);
 
   // 2. Nodes.
   std::vector<Vec3> node;

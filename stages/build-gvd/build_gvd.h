@@ -25,6 +25,10 @@ struct BuildGvdOptions {
   /// boundaries (whole wedges of space project onto them), which is where the graph must connect sheets;
   /// ball samples follow the seed density.
   double space_fraction = 0.25;
+  /// --curve-samples: "tangent", the ball samples of curve and corner seeds (rank 2, 3) are drawn again in
+  /// the tangent plane where they landed, for an even density on each sheet up to where sheets cross;
+  /// "ball", every ball sample as it lands.
+  std::string curve_samples = "tangent";
   /// Radius of the ball around each seed, as a multiple of the distance to its 6th-nearest seed (about one
   /// seed spacing on a sheet) (--ball-scale).
   double ball_scale = 1.0;
@@ -56,6 +60,7 @@ struct BuildGvdOptions {
 struct BuildGvdStats {
   size_t samples_drawn = 0;
   size_t samples_projected = 0;   ///< converged onto the zero set
+  size_t samples_redrawn = 0;     ///< ball samples of curve seeds replaced by their tangent-plane redraw (step 1b)
   size_t samples_duplicate = 0;   ///< dropped because another node sits at (numerically) the same place
   size_t seeds_duplicate = 0;     ///< seeds in the same Morton cell as an earlier seed, left out (no faces)
   size_t nodes = 0;               ///< graph nodes: seeds + kept samples
@@ -79,6 +84,9 @@ struct GvdResult {
 ///     ball around each seed (radius: ball_scale x distance to its 6th-nearest seed; samples per ball in
 ///     proportion to radius^2, so that the density on the surface is even); each projected with x <- x - d n (common/projection.h); unconverged ones dropped.
 ///     Point i draws from the counter-based stream (seed, i), so the draw does not depend on the threads.
+///     With curve_samples "tangent", the ball samples of rank-2 and rank-3 seeds are then drawn again in a
+///     disc of the ball's radius in the tangent plane where they landed and projected again; a redraw that
+///     lands on a sheet of another normal (or fails) keeps the first landing point.
 ///  2. The seeds join the samples as graph nodes (each labelled with its own index at distance 0: the seeds
 ///     are the sources of the sweep). Nodes are sorted along a Morton curve; a sample that shares a Morton
 ///     cell (2^-21 of the box) with an earlier node is dropped as a duplicate (whole wedges of space project
@@ -91,7 +99,7 @@ struct GvdResult {
 ///     neighbours, the triangle (i, j, k), each vertex triple once.
 ///
 /// \param udf    the field; its domain box sets every relative length
-/// \param seeds  the sources (N >= 1), usually from optimize-seeds; only positions are used
+/// \param seeds  the sources (N >= 1), usually from optimize-seeds; positions and ranks are used
 /// \param with_graph  also return the pruned edges in result.samples.edges (indices into result.samples)
 /// \pre options.Check() passes. Throws InputError when `seeds` is empty, NumericalError when no triangle results.
 /// Deterministic: the same inputs and options give the same result whatever the thread count.

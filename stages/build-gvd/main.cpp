@@ -23,6 +23,10 @@ int main(int argc, char** argv) {
   app.add_flag("--graph", graph, "with --labels: also write the pruned kNN graph as an edge element");
   app.add_option("--samples-per-seed", options.samples_per_seed, "dense samples drawn per seed");
   app.add_option("--space-fraction", options.space_fraction, "fraction of dense samples drawn in the whole box");
+  app.add_option("--curve-samples", options.curve_samples,
+                 "tangent: curve and corner seeds' ball samples drawn again in the tangent plane where they landed "
+                 "(even density up to where sheets cross); ball: as they land")
+      ->check(CLI::IsMember({"tangent", "ball"}));
   app.add_option("--ball-scale", options.ball_scale, "ball radius around a seed / distance to its 6th-nearest seed");
   app.add_option("--knn", options.knn, "neighbours per sample in the kNN graph");
   app.add_option("--eps-udf-rel", options.eps_udf_rel, "prune edges with midpoint UDF above this x diagonal");
