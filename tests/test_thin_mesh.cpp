@@ -174,6 +174,39 @@ TEST(ThinMesh, AFinOnASurfaceGoesButNoHoleIsOpened) {
   for (const Vec3& v : out2.vertices) EXPECT_EQ(v.z(), 0.0) << "the pyramid is the side removed";
 }
 
+TEST(ThinMesh, ASheetPieceBetweenBranchingCurvesIsNotALayerAndStays) {
+  const auto udf = MakeShape("disc");
+  TriangleMesh m;
+  AddGrid(m, 6, 6);  // vertex (i, j) is j * 7 + i
+  // Walls of height 0.1 stand on the outline of cells (2..3, 2..3): its 8 base edges branch, and the 8
+  // grid faces inside are a small component bounded by them. Removing it leaves every base edge two faces
+  // (the grid outside and the wall), so the paper's rule removes it and opens a hole under the walls; but
+  // no face that stays lies near it (the grid outside is at 180 degrees, the wall at 90), so it is the
+  // only surface there and stays.
+  const std::vector<int> loop = {16, 17, 18, 25, 32, 31, 30, 23};
+  std::vector<int> top;
+  for (int v : loop) top.push_back(AddVertex(m, m.vertices[static_cast<size_t>(v)] + Vec3(0.0, 0.0, 0.1)));
+  for (size_t k = 0; k < loop.size(); ++k) {
+    const size_t n = (k + 1) % loop.size();
+    m.faces.push_back({loop[k], loop[n], top[n]});
+    m.faces.push_back({loop[k], top[n], top[k]});
+  }
+  const TriangleMesh out = ThinMesh(*udf, m, ThinMeshOptions{}, Monitor::Null());
+  const TopologyStats topo = ComputeTopology(out);
+  EXPECT_EQ(out.faces.size(), 72u + 16u);
+  EXPECT_EQ(topo.nonmanifold_edges, 8u);
+  EXPECT_EQ(topo.boundary_edges, 24u + 8u);  // the grid's outline and the walls' top
+  EXPECT_EQ(topo.euler, 1);                  // a disc with an annulus glued along a loop
+
+  for (const double angle : {180.0, 95.0}) {  // the paper's rule; a layer angle above the walls' 90
+    ThinMeshOptions o;
+    o.layer_angle_deg = angle;
+    const TopologyStats t = ComputeTopology(ThinMesh(*udf, m, o, Monitor::Null()));
+    EXPECT_EQ(t.nonmanifold_edges, 0u) << angle;
+    EXPECT_EQ(t.euler, 0) << angle << ": the grid got a hole under the walls";
+  }
+}
+
 TEST(ThinMesh, DuplicateAndDegenerateFacesNeverSurvive) {
   const auto udf = MakeShape("disc");
   TriangleMesh m;
@@ -344,6 +377,11 @@ TEST(ThinMesh, BadOptionsAreUsageErrors) {
   ThinMeshOptions t;
   t.thinning = "repair";
   EXPECT_THROW(t.Check(), UsageError);
+  for (const double angle : {0.0, 181.0}) {
+    ThinMeshOptions l;
+    l.layer_angle_deg = angle;
+    EXPECT_THROW(l.Check(), UsageError) << angle;
+  }
 }
 
 class ThinMeshExe : public ::testing::Test {

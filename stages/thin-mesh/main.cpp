@@ -26,6 +26,9 @@ int main(int argc, char** argv) {
                  "paper: the paper's two steps only; close-holes: then close the junction gaps the dual left and "
                  "collapse the flaps that leaves dangling")
       ->check(CLI::IsMember({"paper", "close-holes"}));
+  app.add_option("--layer-angle", options.layer_angle_deg,
+                 "a small component without a free edge is removed only if it lies within this angle (deg) of "
+                 "faces that stay (a second layer); 180: always, as the paper");
   app.add_option("--overlap-angle", options.overlap_angle_deg,
                  "a face added to close a gap must not lie within this angle (deg) of a face on its edges");
 

@@ -35,8 +35,11 @@ struct TriHash {
 /// The mutable state of the thinning: faces, which are still present, and the valence of every edge.
 class Thinner {
  public:
-  Thinner(std::vector<Tri> faces, std::vector<double> centroid_udf)
-      : faces_(std::move(faces)), udf_(std::move(centroid_udf)), alive_(faces_.size(), 1) {
+  /// vertices, layer_cos: for the layer test of RemoveComponentIfSafe (layer_cos <= -1 or no vertices: none).
+  Thinner(std::vector<Tri> faces, std::vector<double> centroid_udf, const std::vector<Vec3>* vertices = nullptr,
+          double layer_cos = -1.0)
+      : faces_(std::move(faces)), udf_(std::move(centroid_udf)), alive_(faces_.size(), 1), vertices_(vertices),
+        layer_cos_(layer_cos) {
     incidence_ = BuildEdgeFaces(faces_);
     valence_.resize(incidence_.edges.size());
     for (size_t e = 0; e < valence_.size(); ++e) valence_[e] = static_cast<int>(incidence_.faces[e].size());
@@ -184,9 +187,10 @@ class Thinner {
   }
 
   /// Removes `comp` unless that would leave one of its border edges with a single face (a new hole).
-  /// Removes the faces of `comp` unless that would leave one of its border edges with a single face. With
-  /// `collapse_only`, also unless the component hangs from a free (boundary) edge and its removal keeps the
-  /// Euler characteristic: a dangling flap collapsed from its free edge, which changes no topology.
+  /// Removes the faces of `comp` unless that would leave one of its border edges with a single face, or,
+  /// for a component without a free edge, unless it is a layer (IsLayer). With `collapse_only`, also unless
+  /// the component hangs from a free (boundary) edge and its removal keeps the Euler characteristic: a
+  /// dangling flap collapsed from its free edge, which changes no topology.
   bool RemoveComponentIfSafe(const std::vector<int>& comp, bool collapse_only) {
     std::unordered_map<int, int> uses;  // edge -> faces of comp on it
     std::unordered_map<int, int> corner_uses;  // vertex -> faces of comp on it
@@ -203,6 +207,7 @@ class Thinner {
       free_edge = free_edge || v == 1;
       edges_gone += c == v;
     }
+    if (!free_edge && !IsLayer(comp, uses)) return false;
     if (collapse_only) {
       long vertices_gone = 0;
       for (const auto& [v, c] : corner_uses) vertices_gone += c == vertex_faces_[static_cast<size_t>(v)];
@@ -210,6 +215,36 @@ class Thinner {
       if (!free_edge || vertices_gone - edges_gone + static_cast<long>(comp.size()) != 0) return false;
     }
     for (int f : comp) Remove(f);
+    return true;
+  }
+
+  /// Whether every face of `comp` on one of its border edges lies over a face that stays on that edge: their
+  /// third vertices, seen from the edge, within the layer angle. Then the component is a second layer (the
+  /// cap of a bubble, a fold over a sheet) and removing it uncovers nothing; otherwise it is the only
+  /// surface there, e.g. a strip of a sheet between branching curves. Always true without a layer angle.
+  bool IsLayer(const std::vector<int>& comp, const std::unordered_map<int, int>& uses) const {
+    if (!vertices_ || layer_cos_ <= -1.0) return true;
+    const std::unordered_set<int> in(comp.begin(), comp.end());
+    const std::vector<Vec3>& p = *vertices_;
+    for (const auto& [e, c] : uses) {
+      if (c == valence_[static_cast<size_t>(e)]) continue;  // inside the component
+      const auto& ab = incidence_.edges[static_cast<size_t>(e)];
+      const Vec3 a = p[static_cast<size_t>(ab[0])], axis = (p[static_cast<size_t>(ab[1])] - a).normalized();
+      auto away = [&](int f) {  // from the edge towards the face's third vertex, unit
+        const Tri& t = faces_[static_cast<size_t>(f)];
+        Vec3 d = p[static_cast<size_t>(t[0] + t[1] + t[2] - ab[0] - ab[1])] - a;
+        d -= d.dot(axis) * axis;
+        return Vec3(d.normalized());
+      };
+      for (int f : incidence_.faces[static_cast<size_t>(e)]) {
+        if (!alive_[static_cast<size_t>(f)] || !in.count(f)) continue;
+        const Vec3 mine = away(f);
+        bool covered = false;
+        for (int g : incidence_.faces[static_cast<size_t>(e)])
+          covered = covered || (alive_[static_cast<size_t>(g)] && !in.count(g) && away(g).dot(mine) >= layer_cos_);
+        if (!covered) return false;
+      }
+    }
     return true;
   }
 
@@ -268,6 +303,8 @@ class Thinner {
   EdgeFaces incidence_;
   std::vector<int> valence_;  ///< present faces per edge
   std::vector<int> vertex_faces_;  ///< present faces per vertex
+  const std::vector<Vec3>* vertices_;
+  double layer_cos_;
   std::vector<std::array<int, 3>> face_edges_;
   std::unordered_map<Tri, int, TriHash> by_vertices_;
 };
@@ -283,6 +320,7 @@ void ThinMeshOptions::Check() const {
   if (min_component_faces > 1000000) throw UsageError("--min-component-faces must be at most 1e6");
   if (!(overlap_angle_deg >= 0.0 && overlap_angle_deg < 90.0)) throw UsageError("--overlap-angle must be in [0, 90)");
   if (thinning != "paper" && thinning != "close-holes") throw UsageError("--thinning must be paper or close-holes");
+  if (!(layer_angle_deg > 0.0 && layer_angle_deg <= 180.0)) throw UsageError("--layer-angle must be in (0, 180]");
   if (!(degenerate_quality >= 0.0 && degenerate_quality < 0.5))
     throw UsageError("--degenerate-quality must be in [0, 0.5)");
 }
@@ -372,8 +410,10 @@ void PaperThinning(Thinner& thinner, const ThinMeshOptions& options, ThinMeshSta
     monitor.Warn(Count(st.small_components_left, "small components are left: removing them would open a hole"));
 }
 
-// A Thinner over `faces`, with their centroids' UDF values (the order of removals).
-Thinner MakeThinner(const Udf& udf, const std::vector<Vec3>& vertices, std::vector<Tri> faces) {
+// A Thinner over `faces`, with their centroids' UDF values (the order of removals) and the layer test of
+// `options` (none with --thinning paper).
+Thinner MakeThinner(const Udf& udf, const std::vector<Vec3>& vertices, std::vector<Tri> faces,
+                    const ThinMeshOptions& options) {
   std::vector<Vec3> centroid(faces.size());
   for (size_t f = 0; f < faces.size(); ++f)
     centroid[f] = (vertices[static_cast<size_t>(faces[f][0])] + vertices[static_cast<size_t>(faces[f][1])] +
@@ -382,7 +422,8 @@ Thinner MakeThinner(const Udf& udf, const std::vector<Vec3>& vertices, std::vect
   std::vector<double> centroid_udf;
   std::vector<Vec3> centroid_grad;
   udf.Evaluate(centroid, centroid_udf, centroid_grad);
-  return Thinner(std::move(faces), std::move(centroid_udf));
+  const double layer_cos = options.thinning == "paper" ? -1.0 : std::cos(options.layer_angle_deg * M_PI / 180.0);
+  return Thinner(std::move(faces), std::move(centroid_udf), &vertices, layer_cos);
 }
 
 std::vector<Tri> AliveFaces(const Thinner& thinner) {
@@ -401,7 +442,7 @@ TriangleMesh ThinMesh(const Udf& udf, const TriangleMesh& thick, const ThinMeshO
   std::vector<Tri> faces = CleanFaces(thick, options.degenerate_quality, st);
   monitor.Info(Count(thick.faces.size(), "faces in; dropped ") + Count(st.degenerate_faces, "degenerate and ") +
                Count(st.duplicate_faces, "duplicate faces"));
-  Thinner thinner = MakeThinner(udf, thick.vertices, std::move(faces));
+  Thinner thinner = MakeThinner(udf, thick.vertices, std::move(faces), options);
   PaperThinning(thinner, options, st, monitor);
   std::vector<Tri> kept = AliveFaces(thinner);
   if (options.thinning != "paper") {
@@ -415,7 +456,7 @@ TriangleMesh ThinMesh(const Udf& udf, const TriangleMesh& thick, const ThinMeshO
     // a free edge, with its other edges now shared by 3 faces. Removing such a flap is a collapse: it
     // changes neither chi nor any other edge's count below 2.
     if (st.cracks_split + st.holes_closed > 0) {
-      Thinner flaps = MakeThinner(udf, thick.vertices, std::move(kept));
+      Thinner flaps = MakeThinner(udf, thick.vertices, std::move(kept), options);
       st.flap_faces_removed = RemoveSmallComponents(flaps, options.min_component_faces, true, "dangling flaps: ", st, monitor);
       kept = AliveFaces(flaps);
     }

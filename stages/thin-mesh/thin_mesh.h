@@ -25,6 +25,10 @@ struct ThinMeshOptions {
   /// --overlap-angle (degrees): a face added by closing a gap must not lie within this angle of a face on
   /// one of its edges, seen from the edge (at an open rim, that is the face already there).
   double overlap_angle_deg = 25.0;
+  /// --layer-angle (degrees; not with --thinning paper): step 2 removes a small component that has no free
+  /// edge only if each of its faces on a border edge lies within this angle of a face that stays on that
+  /// edge (a second layer: a bubble's cap, a fold); 180 removes every small component, as the paper does.
+  double layer_angle_deg = 60.0;
 
   /// Throws UsageError for values that cannot work.
   void Check() const;
@@ -57,7 +61,8 @@ struct ThinMeshStats {
 ///     Repeated until a pass removes nothing.
 ///  2. Small components: maximal sets of faces connected across manifold edges (valence 2), i.e. a
 ///     component ends at boundary and non-manifold edges. A component with < min_component_faces faces is
-///     removed when that leaves every one of its non-manifold border edges with 2+ faces (no new hole);
+///     removed when that leaves every one of its non-manifold border edges with 2+ faces (no new hole) and,
+///     unless thinning is "paper", when it has a free edge or is a layer (layer_angle_deg);
 ///     largest mean centroid UDF first (Fig. 8's rule), repeated until none can go.
 ///  3. Steps 1-2 repeat until neither changes the mesh.
 ///  4. Unless thinning is "paper": SplitFacesOverCracks, then CloseTriangularHoles (close_holes.h).
