@@ -452,12 +452,20 @@ TriangleMesh ThinMesh(const Udf& udf, const TriangleMesh& thick, const ThinMeshO
     st.holes_closed = CloseTriangularHoles(thick.vertices, kept, options.degenerate_quality, min_cos);
     monitor.Info(Count(st.cracks_split, "faces split over a crack (T-junction), ") +
                  Count(st.holes_closed, "triangular holes and notches closed"));
-    // 5. Dangling flaps: a face step 4 gives a junction can leave the face the dual put there hanging from
-    // a free edge, with its other edges now shared by 3 faces. Removing such a flap is a collapse: it
-    // changes neither chi nor any other edge's count below 2.
+    // 5. What step 4 closed: its faces can close a tetrahedron where two corners or a corner and a curve
+    // are a fraction of a spacing apart (step 1's rule thins it), and can leave the face the dual put at a
+    // junction hanging from a free edge, its other edges now shared by 3 faces. Removing such a flap is a
+    // collapse: it changes neither chi nor any other edge's count below 2.
     if (st.cracks_split + st.holes_closed > 0) {
       Thinner flaps = MakeThinner(udf, thick.vertices, std::move(kept), options);
+      for (;;) {
+        const size_t thinned = flaps.ThinPass(flaps.Tetrahedra());
+        st.tetrahedra_closed_thinned += thinned;
+        if (thinned == 0) break;
+      }
       st.flap_faces_removed = RemoveSmallComponents(flaps, options.min_component_faces, true, "dangling flaps: ", st, monitor);
+      if (st.tetrahedra_closed_thinned > 0)
+        monitor.Info(Count(st.tetrahedra_closed_thinned, "tetrahedra that step 4 closed thinned"));
       kept = AliveFaces(flaps);
     }
   }

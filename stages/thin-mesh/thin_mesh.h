@@ -46,6 +46,7 @@ struct ThinMeshStats {
   size_t small_components_left = 0; ///< small components whose removal would have opened a hole
   size_t cracks_split = 0;          ///< step 4: faces split over a vertex on their boundary edge (T-junctions)
   size_t holes_closed = 0;          ///< step 4: triangular holes and notches given their face
+  size_t tetrahedra_closed_thinned = 0;  ///< step 5: tetrahedra that step 4's faces closed, thinned
   size_t flap_faces_removed = 0;    ///< step 5: faces of dangling flaps removed
   int rounds = 0;                   ///< rounds of (tetrahedra, components) until nothing changed
 };
@@ -66,9 +67,9 @@ struct ThinMeshStats {
 ///     largest mean centroid UDF first (Fig. 8's rule), repeated until none can go.
 ///  3. Steps 1-2 repeat until neither changes the mesh.
 ///  4. Unless thinning is "paper": SplitFacesOverCracks, then CloseTriangularHoles (close_holes.h).
-///  5. Then, if step 4 changed anything: a small component (as in step 2) that has a free edge is removed
-///     when that leaves no border edge with a single face and keeps the Euler characteristic (a dangling
-///     flap, collapsed from its free edge).
+///  5. Then, if step 4 changed anything: the closed tetrahedra (step 1's rule), and a small component (as in
+///     step 2) that has a free edge is removed when that leaves no border edge with a single face and keeps
+///     the Euler characteristic (a dangling flap, collapsed from its free edge).
 ///  Manifold components are then oriented consistently, unreferenced vertices dropped (order kept).
 ///
 /// \param udf    the field, for the centroid values
