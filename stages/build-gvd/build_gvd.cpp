@@ -83,8 +83,12 @@ void BuildGvdOptions::Check() const {
 
 namespace {
 
-// What step 1b needs of each ball sample (index i - in_space): its seed, and a point of the unit disc drawn
-// from the sample's own stream; and each seed's ball radius.
+// Step 1b redraws the ball samples of these: seeds on a crease, a branching curve or a corner.
+bool IsCurveSeed(const SeedCloud& seeds, size_t s) { return seeds.rank[s] >= kRankEdge; }
+
+// What step 1b needs of each ball sample (index i - in_space): its seed, and (with --curve-samples
+// tangent, for a curve seed's sample) a point of the unit disc drawn from the sample's own stream, after
+// its ball point; and each seed's ball radius.
 struct TangentDraws {
   std::vector<int> owner;
   std::vector<std::array<double, 2>> disc;
@@ -122,9 +126,10 @@ std::vector<Vec3> DrawSamples(const SeedCloud& seeds, const Box& box, const Buil
     }
     ball_end[num_seeds - 1] = total - in_space;
   }
+  const bool redraw = options.curve_samples == "tangent";
   TangentDraws tangent;
   tangent.owner.resize(total - in_space);
-  tangent.disc.resize(total - in_space);
+  if (redraw) tangent.disc.resize(total - in_space);
   std::vector<Vec3> samples(total);
 #pragma omp parallel for schedule(static)
   for (long li = 0; li < static_cast<long>(total); ++li) {
@@ -140,13 +145,14 @@ std::vector<Vec3> DrawSamples(const SeedCloud& seeds, const Box& box, const Buil
       for (int c = 0; c < 3; ++c) u[c] = rng.Uniform(-1.0, 1.0);
     } while (u.squaredNorm() > 1.0);
     samples[i] = seeds.position[s] + radius[s] * u;
+    tangent.owner[i - in_space] = static_cast<int>(s);
+    if (!redraw || !IsCurveSeed(seeds, s)) continue;
     double a, b;
     do {
       a = rng.Uniform(-1.0, 1.0);
       b = rng.Uniform(-1.0, 1.0);
     } while (a * a + b * b > 1.0);
     tangent.disc[i - in_space] = {a, b};
-    tangent.owner[i - in_space] = static_cast<int>(s);
   }
   tangent.radius = std::move(radius);
   *in_space_out = in_space;
@@ -172,7 +178,7 @@ size_t RedrawInTangentDiscs(const Udf& udf, const SeedCloud& seeds, const Tangen
   which.reserve(count);
   for (size_t k = 0; k < count; ++k)
     if (projected.converged[in_space + k] && projected.gradient[in_space + k].norm() > 0.5 &&
-        seeds.rank[static_cast<size_t>(tangent.owner[k])] >= kRankEdge)
+        IsCurveSeed(seeds, static_cast<size_t>(tangent.owner[k])))
       which.push_back(k);
   std::vector<Vec3> redrawn(which.size());
 #pragma omp parallel for schedule(static)

@@ -56,6 +56,12 @@ class Thinner {
   }
 
   const std::vector<Tri>& faces() const { return faces_; }
+  /// The centroid UDF of the present face over the vertices of `t` (any order), if there is one.
+  bool CentroidUdf(const Tri& t, double* udf) const {
+    const int f = Present(Sorted(t));
+    if (f >= 0) *udf = udf_[static_cast<size_t>(f)];
+    return f >= 0;
+  }
   const std::vector<char>& alive() const { return alive_; }
 
   /// Closed tetrahedra among the present faces: for each, its 4 faces (abc, abd, acd, bcd with a<b<c<d),
@@ -186,7 +192,6 @@ class Thinner {
     return comps;
   }
 
-  /// Removes `comp` unless that would leave one of its border edges with a single face (a new hole).
   /// Removes the faces of `comp` unless that would leave one of its border edges with a single face, or,
   /// for a component without a free edge, unless it is a layer (IsLayer). With `collapse_only`, also unless
   /// the component hangs from a free (boundary) edge and its removal keeps the Euler characteristic: a
@@ -207,12 +212,14 @@ class Thinner {
       free_edge = free_edge || v == 1;
       edges_gone += c == v;
     }
-    if (!free_edge && !IsLayer(comp, uses)) return false;
     if (collapse_only) {
+      if (!free_edge) return false;
       long vertices_gone = 0;
       for (const auto& [v, c] : corner_uses) vertices_gone += c == vertex_faces_[static_cast<size_t>(v)];
       // chi = V - E + F changes by -(vertices_gone - edges_gone + faces)
-      if (!free_edge || vertices_gone - edges_gone + static_cast<long>(comp.size()) != 0) return false;
+      if (vertices_gone - edges_gone + static_cast<long>(comp.size()) != 0) return false;
+    } else if (!free_edge && !IsLayer(comp, uses)) {
+      return false;
     }
     for (int f : comp) Remove(f);
     return true;
@@ -411,17 +418,23 @@ void PaperThinning(Thinner& thinner, const ThinMeshOptions& options, ThinMeshSta
 }
 
 // A Thinner over `faces`, with their centroids' UDF values (the order of removals) and the layer test of
-// `options` (none with --thinning paper).
+// `options` (none with --thinning paper). The UDF is asked only for the faces `known` (optional) has not.
 Thinner MakeThinner(const Udf& udf, const std::vector<Vec3>& vertices, std::vector<Tri> faces,
-                    const ThinMeshOptions& options) {
-  std::vector<Vec3> centroid(faces.size());
-  for (size_t f = 0; f < faces.size(); ++f)
-    centroid[f] = (vertices[static_cast<size_t>(faces[f][0])] + vertices[static_cast<size_t>(faces[f][1])] +
-                   vertices[static_cast<size_t>(faces[f][2])]) /
-                  3.0;
-  std::vector<double> centroid_udf;
+                    const ThinMeshOptions& options, const Thinner* known = nullptr) {
+  std::vector<double> centroid_udf(faces.size(), 0.0);
+  std::vector<size_t> ask;
+  std::vector<Vec3> centroid;
+  for (size_t f = 0; f < faces.size(); ++f) {
+    if (known && known->CentroidUdf(faces[f], &centroid_udf[f])) continue;
+    ask.push_back(f);
+    centroid.push_back((vertices[static_cast<size_t>(faces[f][0])] + vertices[static_cast<size_t>(faces[f][1])] +
+                        vertices[static_cast<size_t>(faces[f][2])]) /
+                       3.0);
+  }
+  std::vector<double> asked;
   std::vector<Vec3> centroid_grad;
-  udf.Evaluate(centroid, centroid_udf, centroid_grad);
+  udf.Evaluate(centroid, asked, centroid_grad);
+  for (size_t k = 0; k < ask.size(); ++k) centroid_udf[ask[k]] = asked[k];
   const double layer_cos = options.thinning == "paper" ? -1.0 : std::cos(options.layer_angle_deg * M_PI / 180.0);
   return Thinner(std::move(faces), std::move(centroid_udf), &vertices, layer_cos);
 }
@@ -457,7 +470,7 @@ TriangleMesh ThinMesh(const Udf& udf, const TriangleMesh& thick, const ThinMeshO
     // junction hanging from a free edge, its other edges now shared by 3 faces. Removing such a flap is a
     // collapse: it changes neither chi nor any other edge's count below 2.
     if (st.cracks_split + st.holes_closed > 0) {
-      Thinner flaps = MakeThinner(udf, thick.vertices, std::move(kept), options);
+      Thinner flaps = MakeThinner(udf, thick.vertices, std::move(kept), options, &thinner);
       for (;;) {
         const size_t thinned = flaps.ThinPass(flaps.Tetrahedra());
         st.tetrahedra_closed_thinned += thinned;
