@@ -7,6 +7,7 @@
 #include <functional>
 #include <set>
 
+#include "common/counting_udf.h"
 #include "common/errors.h"
 #include "common/mesh_udf.h"
 #include "common/projection.h"
@@ -634,6 +635,37 @@ void ExpectRankTwoOnFeatures(const std::string& shape, const std::function<doubl
             << shape << ": ranks " << level(i) << " and " << level(j);
       }
   EXPECT_LT(cv_out, NearestNeighbourCv(in.position) / cv_factor) << shape;
+}
+
+// --repulsion-cells first draws no cells in an outer iteration's later repulsion rounds: fewer queries, and
+// the ranks those rounds keep still put every corner and as many seeds on the edges.
+TEST(OptimizeSeeds, RepulsionRoundsOnTheFirstRoundsCellsAskLessAndKeepTheFeatures) {
+  const auto cube = MakeShape("cube");
+  const SeedCloud in = Initial(*cube, 800, 3);
+  auto run = [&](const std::string& mode, uint64_t* queries) {
+    auto usage = std::make_shared<UdfUsage>();
+    const CountingUdf udf(MakeShape("cube"), usage);
+    OptimizeSeedsOptions o;
+    o.seed = 1;
+    o.repulsion_cells = mode;
+    const SeedCloud out = OptimizeSeeds(udf, in, o, Monitor::Null());
+    *queries = usage->queries.load();
+    return out;
+  };
+  uint64_t every_q = 0, first_q = 0;
+  const SeedCloud every = run("every", &every_q), first = run("first", &first_q);
+  EXPECT_LT(first_q, every_q * 9 / 10) << "first " << first_q << " vs every " << every_q << " queries";
+  auto count = [&](const SeedCloud& s, uint8_t rank) {
+    size_t n = 0;
+    for (size_t i = 0; i < s.size(); ++i) {
+      EXPECT_LT(cube->Distance(s.position[i]), 1e-5 * cube->Domain().Diagonal());
+      n += s.rank[i] == rank;
+    }
+    return static_cast<double>(n);
+  };
+  EXPECT_EQ(count(first, 3), 8.0);
+  EXPECT_NEAR(count(first, 2), count(every, 2), 0.15 * count(every, 2));
+  EXPECT_LT(NearestNeighbourCv(first.position, nullptr), 1.15 * NearestNeighbourCv(every.position, nullptr));
 }
 
 TEST(OptimizeSeeds, CrossingPlanesRankTwoSeedsOnTheIntersectionLineOrTheRims) {

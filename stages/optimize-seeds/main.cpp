@@ -27,6 +27,7 @@ int main(int argc, char** argv) {
   app.add_option("--early-samples", o.early_samples, "a cell whose first N samples clearly show one plane keeps those N (0: all get M)");
   app.add_option("--cell-samples", o.cell_samples, "pool: a cell's samples come from one point set kept for the run, with their UDF values; fresh: new draws every round (the paper)");
   app.add_option("--pool-layers", o.pool_layers, "with --cell-samples pool: independent point sets the rounds take in turn");
+  app.add_option("--repulsion-cells", o.repulsion_cells, "every: each repulsion round draws the cells again (the paper); first: only an outer iteration's first, later rounds keep its ranks");
   app.add_option("--gamma", o.gamma, "proximity weight of the L1 step (lengths relative to the diagonal)");
   app.add_option("--delta", o.delta, "inner loop stops when the projected gradient changes by less than this");
   app.add_option("--max-outer-iters", o.max_outer_iters, "cap on outer iterations (L1 step + repulsion)");

@@ -36,6 +36,7 @@ void OptimizeSeedsOptions::Check() const {
   if (!(cell_radius_factor > 0.0 && cell_radius_factor <= 10.0)) throw UsageError("--cell-radius-factor must be in (0, 10]");
   if (!(max_step >= 0.0 && max_step <= 100.0)) throw UsageError("--max-step must be in [0, 100]");
   if (cell_samples != "pool" && cell_samples != "fresh") throw UsageError("--cell-samples must be pool or fresh");
+  if (repulsion_cells != "every" && repulsion_cells != "first") throw UsageError("--repulsion-cells must be every or first");
   if (!(pool_layers >= 1 && pool_layers <= 64)) throw UsageError("--pool-layers must be in [1, 64]");
   if (!(sigma_max_spacing >= 0.0 && sigma_max_spacing <= 10.0)) throw UsageError("--sigma-max-spacing must be in [0, 10]");
   if (!(sigma_min_spacing >= 0.0 && sigma_min_spacing <= 10.0)) throw UsageError("--sigma-min-spacing must be in [0, 10]");
@@ -327,6 +328,19 @@ class Optimizer {
                    std::to_string(cells.early_cells) + " of them with their early samples only, " +
                    std::to_string(cells.reused) + " samples' UDF values reused");
     return cells;
+  }
+
+  // Between repulsion rounds without new cells (--repulsion-cells first): ranks stay, a seed that moves in a
+  // plane (a sheet seed) takes the tangent plane of its own gradient where Project left it, which is the
+  // surface's there; a curve seed keeps its line, a corner stays fixed.
+  void FollowTangentPlanes(State& s) const {
+    for (size_t i = 0; i < s.position.size(); ++i) {
+      if (s.space[i].dim != 2 || s.normal[i].squaredNorm() < 0.25) continue;
+      const TangentRank own = ComputeTangentRank(&s.normal[i], 1, options_.rank_threshold);
+      if (own.rank != 1) continue;
+      s.space[i].basis.setZero();
+      s.space[i].basis.leftCols<2>() = own.v.rightCols<2>();
+    }
   }
 
   // Paper Eq. (energy_l1_regularizer) for every seed, inside its cell. Returns the new (unprojected) positions.
@@ -771,7 +785,11 @@ SeedCloud OptimizeSeeds(const Udf& udf, const SeedCloud& input, const OptimizeSe
       double previous_gradient = -1.0;
       for (int inner = 1; inner <= options.max_inner_iters; ++inner) {
         const auto t0 = Clock::now();
-        opt.Analyze(s, true);
+        if (inner == 1 || options.repulsion_cells == "every") {
+          opt.Analyze(s, true);
+        } else {
+          opt.FollowTangentPlanes(s);
+        }
         if (inner == 1) {
           report.sigma = opt.KernelWidth(s);
           if (!std::isfinite(report.sigma)) break;  // every seed is fixed: nothing to repel

@@ -26,6 +26,11 @@ struct OptimizeSeedsOptions {
   /// --pool-layers: the pool is split into this many independent point sets, which the sampling rounds
   /// take in turn, so that consecutive rounds see independent samples of a cell (1: every round the same).
   int pool_layers = 3;
+  /// --repulsion-cells: "every", every repulsion round draws the cells again for the ranks and move spaces
+  /// (the paper's loop); "first", only the first round of an outer iteration does, and the later rounds keep
+  /// those ranks, a sheet seed moving in the tangent plane of its own gradient. Not in the paper, see
+  /// docs/optimize-seeds.md ("Cells in the repulsion rounds").
+  std::string repulsion_cells = "every";
   double gamma = 10.0;            ///< γ, proximity weight, lengths relative to the domain diagonal (paper: 10) (--gamma)
   double delta = 1e-3;            ///< δ, inner loop stops when the gradient changes by less than this, relatively (paper: 1e-3) (--delta)
   int max_outer_iters = 3;        ///< cap on Alg. 1's outer loop (--max-outer-iters; see docs for why 3)
