@@ -540,6 +540,7 @@ GvdResult BuildGvd(const Udf& udf, const SeedCloud& seeds, const BuildGvdOptions
   std::vector<double> dist;
   std::vector<int> label;
   GeodesicSweep(graph, node, node_seed, &dist, &label, monitor);
+  monitor.Debug("geodesic sweep done");
   for (size_t i = 0; i < n; ++i) stats.unreached += label[i] < 0 ? 1 : 0;
   if (stats.unreached > 0)
     monitor.Warn(Format("%zu of %zu samples are not reached from any seed (label -1)", stats.unreached, n));
@@ -547,6 +548,7 @@ GvdResult BuildGvd(const Udf& udf, const SeedCloud& seeds, const BuildGvdOptions
   // 5-6. Witnessed triples; with the default dual, the locally Delaunay ones.
   std::vector<Tri>& faces = result.thick.faces;
   faces = WitnessedTriples(graph, label);
+  monitor.Debug("witnessed triples listed");
   if (options.dual == "delaunay") {
     RestrictedDualStats rd;
     std::vector<Vec3> seed_normal;
