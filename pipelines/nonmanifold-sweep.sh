@@ -6,7 +6,7 @@
 # Prints one row per shape and count and the total; the runs go two at a time.
 #
 # Usage: pipelines/nonmanifold-sweep.sh [OUT_DIR] [--optimize-seeds "ARGS"] [--build-gvd "ARGS"] [--thin-mesh "ARGS"]
-#   e.g. --build-gvd "--samples-per-seed 100"
+#   e.g. --build-gvd "--samples-per-seed 100"; SEEDS="6 7 8 9 10" for five other --seed values
 set -euo pipefail
 ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 BIN=${VOROUDF_BIN:-$ROOT/build/bin}
@@ -23,7 +23,7 @@ while (($#)); do
 done
 SHAPES=(crossing-planes sphere-disc three-discs)
 COUNTS=(1000 2000 3000 5000)
-SEEDS=(1 2 3 4 5)
+read -r -a SEEDS <<< "${SEEDS:-1 2 3 4 5}"  # SEEDS="6 7 8 9 10": another five draws
 
 one() {
   local shape=$1 count=$2 seed=$3 dir="$OUT/$1-$2-$3"
