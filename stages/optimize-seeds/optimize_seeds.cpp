@@ -309,10 +309,7 @@ class Optimizer {
       if (r.rank == 0) {
         // No usable sample (an empty cell within the budget): move in the tangent plane of the seed's own
         // gradient, as on a sheet, and report rank 0 ("unknown").
-        const TangentRank own = ComputeTangentRank(&s.normal[i], 1, options_.rank_threshold);
-        space.dim = own.rank == 1 ? 2 : 0;
-        space.basis.setZero();
-        space.basis.leftCols<2>() = own.v.rightCols<2>();
+        space = OwnTangentPlane(s.normal[i]);
       } else {
         space.dim = 3 - r.rank;
         space.basis.setZero();
@@ -336,11 +333,19 @@ class Optimizer {
   void FollowTangentPlanes(State& s) const {
     for (size_t i = 0; i < s.position.size(); ++i) {
       if (s.space[i].dim != 2 || s.normal[i].squaredNorm() < 0.25) continue;
-      const TangentRank own = ComputeTangentRank(&s.normal[i], 1, options_.rank_threshold);
-      if (own.rank != 1) continue;
-      s.space[i].basis.setZero();
-      s.space[i].basis.leftCols<2>() = own.v.rightCols<2>();
+      const MoveSpace own = OwnTangentPlane(s.normal[i]);
+      if (own.dim == 2) s.space[i].basis = own.basis;
     }
+  }
+
+  // The plane orthogonal to a seed's own gradient as a move space (dim 2), or dim 0 where the gradient
+  // gives no plane.
+  MoveSpace OwnTangentPlane(const Vec3& normal) const {
+    const TangentRank own = ComputeTangentRank(&normal, 1, options_.rank_threshold);
+    MoveSpace space;
+    space.dim = own.rank == 1 ? 2 : 0;
+    space.basis.leftCols<2>() = own.v.rightCols<2>();
+    return space;
   }
 
   // Paper Eq. (energy_l1_regularizer) for every seed, inside its cell. Returns the new (unprojected) positions.
