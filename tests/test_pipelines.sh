@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # End-to-end tests of the chained executables through the three drivers: pipelines/voroudf.sh,
-# Makefile.example and pipelines/Snakefile. Usage: test_pipelines.sh BIN_DIR {voroudf-sh|make|snakemake|benchmark|noise-study}
+# Makefile.example and pipelines/Snakefile. Usage: test_pipelines.sh BIN_DIR {voroudf-sh|make|snakemake|benchmark|noise-study|feature-misses}
 set -euo pipefail
 BIN=$(cd "$1" && pwd)
 WHAT=$2
@@ -97,6 +97,27 @@ case "$WHAT" in
     cmp -s "$TMP/bench/runs/cad/ball/mesh.ply" "$TMP/bench2/runs/cad/ball/mesh.ply" || fail "--reuse gave another mesh"
     [ "$(cut -f1 "$TMP/bench2/runs/cad/ball/timings.tsv" | tr '\n' ' ')" = "stage thin-mesh " ] ||
       fail "--reuse --from thin-mesh ran other stages"
+    ;;
+  feature-misses)
+    # The cube meshed twice: as is (feature seeds on its edges), and with a rank test that sees no feature
+    # (every seed rank 1). The classes' shares add up to 1 - recall, and without feature seeds every miss
+    # is "no-seed".
+    printf 'OFF\n8 12 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n0 0 1\n1 0 1\n1 1 1\n0 1 1\n3 0 2 1\n3 0 3 2\n3 4 5 6\n3 4 6 7\n3 0 1 5\n3 0 5 4\n3 1 2 6\n3 1 6 5\n3 2 3 7\n3 2 7 6\n3 3 0 4\n3 3 4 7\n' > "$TMP/cube.off"
+    bash "$ROOT/pipelines/voroudf.sh" --udf "$TMP/cube.off" --reference "$TMP/cube.off" -o "$TMP/cube" \
+      --count 600 2> /dev/null
+    bash "$ROOT/pipelines/voroudf.sh" --udf "$TMP/cube.off" --reference "$TMP/cube.off" -o "$TMP/flat" \
+      --count 600 --optimize-seeds "--rank-threshold 0.99 --crease-angle-deg 0" 2> /dev/null
+    "$ROOT/pipelines/feature-misses" --bin "$BIN" "$TMP/cube" "$TMP/flat" > "$TMP/table" 2> "$TMP/log" ||
+      { cat "$TMP/log"; fail "feature-misses failed"; }
+    /usr/bin/python3 - "$TMP/table" <<'PY' || { cat "$TMP/table"; fail "feature-misses: wrong shares"; }
+import sys
+rows = {l.split("|")[1].strip(): [float(x) for x in l.split("|")[2:7]] for l in open(sys.argv[1])
+        if l.startswith("| cube") or l.startswith("| flat")}
+for name, (recall, chord, across, one_side, no_seed) in rows.items():
+    assert abs(chord + across + one_side + no_seed - (1 - recall)) < 0.002, name
+flat = rows["flat"]
+assert rows["cube"][0] > 0.95 and flat[0] < 0.9 and flat[4] > 0.99 * (1 - flat[0]), rows
+PY
     ;;
   noise-study)
     # One ball at three noise levels and as a grid: a row each, none failed, and at a value error of 1e-3
