@@ -118,6 +118,19 @@ for name, (recall, chord, across, one_side, no_seed) in rows.items():
 flat = rows["flat"]
 assert rows["cube"][0] > 0.95 and flat[0] < 0.9 and flat[4] > 0.99 * (1 - flat[0]), rows
 PY
+    # The rank it classes by is the seeds file's rank property, found by name: the cube's seeds have rank-3
+    # corners and rank-2 edge seeds, the flat run's none.
+    /usr/bin/python3 - "$ROOT/pipelines/feature-misses" "$TMP/cube/seeds.ply" "$TMP/flat/seeds.ply" <<'PY' ||
+import sys, importlib.machinery, importlib.util
+loader = importlib.machinery.SourceFileLoader("feature_misses", sys.argv[1])
+fm = importlib.util.module_from_spec(importlib.util.spec_from_loader("feature_misses", loader))
+loader.exec_module(fm)
+_, cube = fm.seed_ranks(sys.argv[2])
+_, flat = fm.seed_ranks(sys.argv[3])
+assert (cube == 3).sum() >= 8 and (cube == 2).sum() > 0 and set(cube) <= {1, 2, 3}, sorted(set(cube))
+assert (flat >= 2).sum() == 0, sorted(set(flat))
+PY
+      fail "feature-misses: the seeds' ranks are not read from their rank property"
     ;;
   noise-study)
     # One ball at three noise levels and as a grid: a row each, none failed, and at a value error of 1e-3

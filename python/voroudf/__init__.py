@@ -288,9 +288,10 @@ _PLY_TYPES = {"char": "i1", "uchar": "u1", "int8": "i1", "uint8": "u1", "short":
               "float": "f4", "float32": "f4", "double": "f8", "float64": "f8"}
 
 
-def read_ply(path):
+def read_ply(path, with_names=False):
     """Reads a binary little-endian PLY as voroudf writes it (docs/formats.md): a dict from element name to
-    an array — (N, properties) for scalar elements, (F, 3) for triangle faces."""
+    an array — (N, properties) for scalar elements, (F, 3) for triangle faces. With `with_names`, also a
+    dict from element name to its property names in column order (property order is free in a PLY file)."""
     with open(path, "rb") as fh:
         raw = fh.read()
     end = raw.index(b"end_header\n") + len(b"end_header\n")
@@ -305,6 +306,7 @@ def read_ply(path):
         elif w and w[0] == "property":
             elements[-1][2].append(w[1:])
     out, at = {}, end
+    names = {name: [p[-1] for p in props] for name, _, props in elements}
     for name, count, props in elements:
         if props and props[0][0] == "list":
             _, ctype, itype, _ = props[0]
@@ -319,4 +321,4 @@ def read_ply(path):
             out[name] = np.stack([rec[p[1]].astype(np.float64) for p in props], axis=1) if count else \
                 np.zeros((0, len(props)))
         at += dt.itemsize * count
-    return out
+    return (out, names) if with_names else out
