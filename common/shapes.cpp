@@ -5,6 +5,7 @@
 #include <functional>
 
 #include "common/errors.h"
+#include "common/triangle_bvh.h"
 
 namespace voroudf {
 namespace {
@@ -133,6 +134,51 @@ class Torus : public Primitive {
   double R_, r_;
 };
 
+// A closed polyhedron given by its triangles: the closest point over them (TriangleBvh), the normal of
+// the closest triangle.
+class Polyhedron : public Primitive {
+ public:
+  explicit Polyhedron(TriangleMesh mesh) : mesh_(std::move(mesh)), bvh_(mesh_.vertices, mesh_.faces) {}
+  Vec3 ClosestPoint(const Vec3& p, Vec3* normal) const override {
+    const TriangleBvh::Hit hit = bvh_.Closest(p);
+    *normal = bvh_.FaceNormal(hit.face);
+    return hit.point;
+  }
+
+ private:
+  TriangleMesh mesh_;
+  TriangleBvh bvh_;
+};
+
+// The prism over a simple polygon (counter-clockwise, star-shaped from its first vertex, so a fan from
+// it triangulates it) between z = -half_height and z = +half_height, faces oriented outwards.
+TriangleMesh PrismMesh(const std::vector<Eigen::Vector2d>& polygon, double half_height) {
+  TriangleMesh m;
+  const int n = static_cast<int>(polygon.size());
+  for (double z : {-half_height, half_height})
+    for (const auto& q : polygon) m.vertices.emplace_back(q.x(), q.y(), z);
+  for (int i = 1; i + 1 < n; ++i) {
+    m.faces.push_back({0, i + 1, i});          // bottom, facing -z
+    m.faces.push_back({n, n + i, n + i + 1});  // top, facing +z
+  }
+  for (int i = 0; i < n; ++i) {
+    const int j = (i + 1) % n;
+    m.faces.push_back({i, j, n + j});
+    m.faces.push_back({i, n + j, n + i});
+  }
+  return m;
+}
+
+// shape:feature-prism's cross-section: an L whose upright ends in a 20° spike at (-0.5, 0.5), with the
+// outer corner (0.5, -0.5) chamfered by 0.06. Its prism has a concave edge (at D), a 0.085 chamfer face
+// whose two short top and bottom edges join close corners, and two sharp edges meeting at 20° (at F).
+std::vector<Eigen::Vector2d> FeaturePrismPolygon() {
+  const double spike = 20.0 * M_PI / 180.0;
+  return {{-0.5, -0.5}, {0.44, -0.5}, {0.5, -0.44}, {0.5, -0.1},
+          {-0.5 + 0.6 * std::tan(spike), -0.1},  // D: the concave corner
+          {-0.5, 0.5}};                           // F: the 20° spike
+}
+
 }  // namespace
 
 std::unique_ptr<Primitive> MakeSphere(const Vec3& c, double r) { return std::make_unique<Sphere>(c, r); }
@@ -196,6 +242,9 @@ const std::vector<ShapeEntry>& Shapes() {
       {"sphere", "sphere of radius 0.5 at the origin", [=] { return Parts(MakeSphere(o, 0.5)); }},
       {"cube", "surface of the cube [-0.5,0.5]^3: 12 sharp edges, 8 corners",
        [=] { return Parts(MakeCubeSurface(0.5)); }},
+      {"feature-prism", "prism |z|<=0.3 over an L with a 20 degree spike and a chamfered corner: a concave edge, "
+                        "short edges between close corners, sharp edges meeting at 20 degrees",
+       [=] { return Parts(std::make_unique<Polyhedron>(ShapeMesh("feature-prism"))); }},
       {"disc", "open disc of radius 0.5 in the plane z=0", [=] { return Parts(MakeDisc(o, z, 0.5)); }},
       {"hemisphere", "open upper hemisphere (z>=0) of the sphere of radius 0.5",
        [=] { return Parts(MakeHemisphere(o, 0.5, z)); }},
@@ -247,10 +296,16 @@ std::vector<Vec3> Segment(const Vec3& a, const Vec3& b) {
 
 }  // namespace
 
+TriangleMesh ShapeMesh(const std::string& name) {
+  if (name == "feature-prism") return PrismMesh(FeaturePrismPolygon(), 0.3);
+  if (name == "cube") return PrismMesh({{-0.5, -0.5}, {0.5, -0.5}, {0.5, 0.5}, {-0.5, 0.5}}, 0.5);
+  throw InputError("shape:" + name, "not a polyhedron (shapes with a triangle mesh: cube, feature-prism)");
+}
+
 ShapeTopology KnownTopology(const std::string& name) {
   ShapeTopology t;
   // chi of a union = sum of the parts' chi - sum over pairwise intersections + the triple one.
-  if (name == "sphere" || name == "cube") t.euler = 2;
+  if (name == "sphere" || name == "cube" || name == "feature-prism") t.euler = 2;
   else if (name == "disc" || name == "hemisphere" || name == "fold") t.euler = 1;
   else if (name == "torus") t.euler = 0;
   else if (name == "sphere-ring") t.euler = 2 + 0;  // two components: a sphere and a torus

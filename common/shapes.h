@@ -53,6 +53,11 @@ std::vector<std::pair<std::string, std::string>> ShapeCatalog();
 /// Builds the named shape; throws InputError listing the known names for an unknown one.
 std::unique_ptr<AnalyticUdf> MakeShape(const std::string& name);
 
+/// The triangle mesh of a polyhedral built-in shape (cube, feature-prism), exactly its surface: its sharp
+/// edges and corners are the shape's, so it serves as the reference for evaluating a mesh of the shape.
+/// Throws InputError for a shape that is not a polyhedron.
+TriangleMesh ShapeMesh(const std::string& name);
+
 /// What is known in closed form of a built-in shape's topology, for tests and the robustness sweep.
 struct ShapeTopology {
   long long euler = 0;  ///< Euler characteristic of the surface

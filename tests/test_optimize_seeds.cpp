@@ -751,7 +751,7 @@ TEST(OptimizeSeeds, AShallowCreaseGetsAChainOfCurveSeeds) {
 // Curved features: with --feature-chord-tol, the chain of seeds on sphere-disc's equator (a circle of radius
 // 0.5, about 4.5 spacings at 200 seeds) follows it to within the tolerance: every chord between consecutive
 // equator seeds that is long enough to be split (2.5 × the feature clearance) has its midpoint within
-// the tolerance of the circle; without it such chords cut inside the circle by more. Seeds were added.
+// the tolerance of the circle; without it such chords cut inside the circle by more. The count holds.
 // The refinement is not certain to reach the tolerance on every chord of every run (a seed added in one
 // round can move its neighbours' chords, and the crowding and clearance rules leave some chords as they
 // are): over input draws 1-8 it did in 4 of 8 with each of two realizations of the sample pool, so the
@@ -791,15 +791,49 @@ TEST(OptimizeSeeds, FeatureChordsFollowACurvedFeatureWithinTheTolerance) {
     const SeedCloud in = Initial(*udf, 200, draw);
     const Chain plain = chain(in, 0.0), refined = chain(in, tol);
     EXPECT_GT(plain.worst, 1.5 * tol * plain.spacing) << "the test shape must bend away from its chords";
-    EXPECT_GT(refined.seeds, plain.seeds) << "draw " << draw;
+    // Seeds are added on the chords, and as many sheet seeds dropped in the outer loop (the count holds).
+    EXPECT_NEAR(static_cast<double>(refined.seeds), static_cast<double>(plain.seeds), 0.05 * plain.seeds) << "draw " << draw;
     within += refined.worst <= 1.2 * tol * refined.spacing;
   }
   EXPECT_GE(within, 2);
 }
 
-// The stopping rules fire before the caps: the inner loop at the first round whose projected gradient
-// does not decrease by δ, the outer loop at the first iteration where σ stops growing and the spacing
-// CV improves by less than outer_tol (and not before it).
+// Feature chains (--feature-gap-max, default 1.5): along every edge of the cube, from corner to corner, no
+// two consecutive feature seeds are farther apart than 1.5 mean spacings (5 % slack: the spacing is the
+// one before seeds were added). Without the rule some chains have longer gaps (1.52–1.67 spacings at 1,000
+// seeds, draws 1–3), so the test can fail.
+TEST(OptimizeSeeds, FeatureChainsHaveNoGapLongerThanTheLimit) {
+  const auto cube = MakeShape("cube");
+  auto largest_gap = [&](const SeedCloud& in, double gap_max) {
+    OptimizeSeedsOptions options;
+    options.feature_gap_max = gap_max;
+    const SeedCloud out = OptimizeSeeds(*cube, in, options, Monitor::Null());
+    double spacing = 0.0;
+    NearestNeighbourCv(out.position, &spacing);
+    double largest = 0.0;
+    for (int axis = 0; axis < 3; ++axis) {
+      const int u = (axis + 1) % 3, v = (axis + 2) % 3;
+      for (double su : {-0.5, 0.5})
+        for (double sv : {-0.5, 0.5}) {
+          std::vector<double> along = {-0.5, 0.5};
+          for (size_t i = 0; i < out.size(); ++i)
+            if (out.rank[i] >= 2 && std::abs(out.position[i][u] - su) < 1e-3 && std::abs(out.position[i][v] - sv) < 1e-3)
+              along.push_back(out.position[i][axis]);
+          std::sort(along.begin(), along.end());
+          for (size_t k = 1; k < along.size(); ++k) largest = std::max(largest, (along[k] - along[k - 1]) / spacing);
+        }
+    }
+    return largest;
+  };
+  double without = 0.0;
+  for (uint64_t draw = 1; draw <= 3; ++draw) {
+    const SeedCloud in = Initial(*cube, 1000, draw);
+    EXPECT_LE(largest_gap(in, 1.5), 1.5 * 1.05) << "draw " << draw;
+    without = std::max(without, largest_gap(in, 0.0));
+  }
+  EXPECT_GT(without, 1.5 * 1.05) << "the test needs a chain with a gap without the rule";
+}
+
 TEST(OptimizeSeeds, SeedsBesideAHigherRankedFeatureSeedAreDropped) {
   const std::vector<Vec3> position = {{0, 0, 0},   {0.05, 0, 0},  {0.02, 0.01, 0}, {0.3, 0, 0},
                                       {0.3, 0.02, 0}, {0.6, 0, 0}, {0.6, 0.01, 0}, {0.62, 0, 0}};
@@ -835,6 +869,9 @@ TEST(OptimizeSeeds, SheetSeedsBetweenTwoCurveSeedsAreDropped) {
   EXPECT_EQ(SeedsBesideFeatures(position, rank, 0.02, {}, along), (std::vector<char>{0, 0, 1, 0, 0, 1}));
 }
 
+// The stopping rules fire before the caps: the inner loop at the first round whose projected gradient
+// does not decrease by δ, the outer loop at the first iteration where σ stops growing and the spacing
+// CV improves by less than outer_tol (and not before it).
 TEST(OptimizeSeeds, StoppingRulesEndTheLoopsBeforeTheirCaps) {
   const auto sphere = MakeShape("sphere");
   const SeedCloud in = Initial(*sphere, 500, 5);
@@ -881,6 +918,13 @@ TEST(OptimizeSeeds, BadOptionsAndInputs) {
   EXPECT_THROW(o.Check(), UsageError);
   o.crease_angle_deg = 43;
   EXPECT_NO_THROW(o.Check());
+  o = OptimizeSeedsOptions();
+  o.feature_gap_max = 0.5;  // below a spacing every chain link would be a gap
+  EXPECT_THROW(o.Check(), UsageError);
+  o.feature_gap_max = 3.0;  // beyond the chain search radius no link is that long
+  EXPECT_THROW(o.Check(), UsageError);
+  o.feature_gap_max = 0.0;
+  EXPECT_NO_THROW(o.Check());
   const auto sphere = MakeShape("sphere");
   SeedCloud one;
   one.Resize(1);
@@ -916,9 +960,11 @@ TEST_F(OptimizeSeedsExe, WritesSeedsOnTheSurfaceWithRanksAndATrace) {
   EXPECT_TRUE(r.out.empty());
   EXPECT_NE(r.err.find("outer 1:"), std::string::npos) << r.err;
   const SeedCloud seeds = ReadSeeds(out);
-  // A few seeds crowding the curves and the point where the three curves meet are dropped, and said so.
+  // A few seeds crowding the curves and the point where the three curves meet are dropped, and said so; seeds
+  // added on the feature chains (step 8) can outnumber the sheet seeds free to make room for them on a shape
+  // this small, most of whose seeds lie near a curve (318 here).
   EXPECT_GE(seeds.size(), 265u);  // 268-279 measured over --seed 2-5 of sample-seeds, both --cell-samples
-  EXPECT_LE(seeds.size(), 300u);
+  EXPECT_LE(seeds.size(), 340u);
   if (seeds.size() < 300u) {
     EXPECT_NE(r.err.find(std::to_string(300 - seeds.size()) + " seeds dropped"), std::string::npos) << r.err;
   }
@@ -929,8 +975,9 @@ TEST_F(OptimizeSeedsExe, WritesSeedsOnTheSurfaceWithRanksAndATrace) {
     ranked += seeds.rank[i] >= 1;
   }
   EXPECT_EQ(ranked, seeds.size());
-  for (const char* name : {"iter-001.ply", "iter-002.ply", "iter-003.ply"})
-    EXPECT_EQ(ReadSeeds(dir_ / ("trace/" + std::string(name))).size(), 300u) << name;
+  EXPECT_EQ(ReadSeeds(dir_ / "trace/iter-001.ply").size(), 300u) << "before any seed is added or dropped";
+  for (const char* name : {"iter-002.ply", "iter-003.ply"})
+    EXPECT_NEAR(static_cast<double>(ReadSeeds(dir_ / ("trace/" + std::string(name))).size()), 300.0, 45.0) << name;
   EXPECT_NE(test::ReadBytes(out).find("comment stage optimize-seeds"), std::string::npos);
   // --trace is debugging output: not in the provenance, and the output is the same bytes without it.
   EXPECT_EQ(test::ReadBytes(out).find("--trace"), std::string::npos);

@@ -2,8 +2,11 @@
 // differences of the distance, and the conventions on the surface and the medial axis.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <functional>
+#include <vector>
 
 #include "common/errors.h"
 #include "common/rng.h"
@@ -47,6 +50,24 @@ double FoldD(const Vec3& p) {
   return std::min(half(p.x(), p.y(), p.z()), half(-(p.x() * c + p.z() * s), p.y(), -p.x() * s + p.z() * c));
 }
 
+// shape:feature-prism: |signed distance| to the solid prism |z| <= 0.3 over the polygon (docs/udf-sources.md),
+// from the 2-D signed distance to the polygon (edges, crossing-number sign) and the slab's.
+double FeaturePrismD(const Vec3& p) {
+  const double xd = -0.5 + 0.6 * std::tan(20.0 * M_PI / 180.0);
+  const std::vector<std::array<double, 2>> poly = {{-0.5, -0.5}, {0.44, -0.5}, {0.5, -0.44}, {0.5, -0.1}, {xd, -0.1}, {-0.5, 0.5}};
+  double edge = INFINITY;
+  bool inside = false;
+  for (size_t i = 0, j = poly.size() - 1; i < poly.size(); j = i++) {
+    const double ax = poly[j][0], ay = poly[j][1], bx = poly[i][0], by = poly[i][1];
+    const double t = std::clamp(((p.x() - ax) * (bx - ax) + (p.y() - ay) * (by - ay)) /
+                                    ((bx - ax) * (bx - ax) + (by - ay) * (by - ay)), 0.0, 1.0);
+    edge = std::min(edge, std::hypot(p.x() - ax - t * (bx - ax), p.y() - ay - t * (by - ay)));
+    if ((ay > p.y()) != (by > p.y()) && p.x() < ax + (p.y() - ay) * (bx - ax) / (by - ay)) inside = !inside;
+  }
+  const double d2 = inside ? -edge : edge, dz = std::abs(p.z()) - 0.3;
+  return std::abs(std::hypot(std::max(d2, 0.0), std::max(dz, 0.0)) + std::min(std::max(d2, dz), 0.0));
+}
+
 struct Case {
   const char* name;
   std::function<double(const Vec3&)> exact;
@@ -58,6 +79,7 @@ const std::vector<Case>& Cases() {
   static const std::vector<Case> cases = {
       {"sphere", SphereD},
       {"cube", CubeD},
+      {"feature-prism", FeaturePrismD},
       {"disc", DiscZ},
       {"hemisphere", HemisphereD},
       {"crossing-planes", [](const Vec3& p) { return std::min(SquareD(p.z(), p.x(), p.y()), SquareD(p.x(), p.y(), p.z())); }},

@@ -43,6 +43,8 @@ void OptimizeSeedsOptions::Check() const {
   if (!(feature_clearance >= 0.0 && feature_clearance <= 1.0)) throw UsageError("--feature-clearance must be in [0, 1]");
   if (feature_steps < 0) throw UsageError("--feature-steps must be at least 0");
   if (!(feature_chord_tol >= 0.0 && feature_chord_tol <= 1.0)) throw UsageError("--feature-chord-tol must be in [0, 1]");
+  if (!(feature_gap_max == 0.0 || (feature_gap_max >= 1.0 && feature_gap_max <= 2.5)))  // 2.5: kFeatureLinkRadius
+    throw UsageError("--feature-gap-max must be 0 or in [1, 2.5]");
   if (sigma_max_spacing > 0.0 && sigma_min_spacing > sigma_max_spacing)
     throw UsageError("--sigma-min-spacing must not exceed --sigma-max-spacing");
   if (!(repulsion_cutoff >= 1.0 && repulsion_cutoff <= 10.0)) throw UsageError("--repulsion-cutoff must be in [1, 10]");
@@ -92,17 +94,23 @@ double TangentMisfit(const CellSamples& cells, size_t i, const Vec3& x) {
   return count > 0 ? sum / static_cast<double>(count) : INFINITY;
 }
 
-// The chords of the feature curves, each pair once and sorted: every curve seed (rank 2, with a tangent)
-// and the nearest feature seed ahead of it and behind it along its tangent (and along the other's, when it
-// has one), within 2.5 spacings.
-std::vector<std::pair<int, int>> FeatureChords(const State& s, const std::vector<Vec3>& tangent, double spacing) {
-  const size_t n = s.position.size();
+// The links of the feature curves: every curve seed (rank 2, with a tangent) and the nearest feature seed
+// ahead of it and behind it along its tangent (and along the other's, when it has one), within `radius`.
+// chords: each such pair once, sorted. ends: a curve seed with no such seed on one side (the chain ends
+// there, or has a gap longer than the radius), with the unit direction of that side.
+struct FeatureLinks {
   std::vector<std::pair<int, int>> chords;
+  std::vector<std::pair<int, Vec3>> ends;
+};
+
+FeatureLinks FindFeatureLinks(const State& s, const std::vector<Vec3>& tangent, double radius) {
+  const size_t n = s.position.size();
+  FeatureLinks links;
   const SeedIndex index(s.position);
   std::vector<int> found;
   for (size_t i = 0; i < n; ++i) {
     if (s.rank[i].rank != 2 || tangent[i].isZero()) continue;
-    index.WithinRadius(s.position[i], 2.5 * spacing, found);
+    index.WithinRadius(s.position[i], radius, found);
     int best[2] = {-1, -1};
     for (int j : found) {  // nearest first
       const size_t uj = static_cast<size_t>(j);
@@ -114,12 +122,18 @@ std::vector<std::pair<int, int>> FeatureChords(const State& s, const std::vector
       int& side = best[along > 0.0 ? 0 : 1];
       if (side < 0) side = j;
     }
-    for (int j : best)
-      if (j >= 0) chords.emplace_back(std::min<int>(static_cast<int>(i), j), std::max<int>(static_cast<int>(i), j));
+    for (int k = 0; k < 2; ++k) {
+      const int j = best[k];
+      if (j >= 0) {
+        links.chords.emplace_back(std::min<int>(static_cast<int>(i), j), std::max<int>(static_cast<int>(i), j));
+      } else {
+        links.ends.emplace_back(static_cast<int>(i), k == 0 ? tangent[i] : Vec3(-tangent[i]));
+      }
+    }
   }
-  std::sort(chords.begin(), chords.end());
-  chords.erase(std::unique(chords.begin(), chords.end()), chords.end());
-  return chords;
+  std::sort(links.chords.begin(), links.chords.end());
+  links.chords.erase(std::unique(links.chords.begin(), links.chords.end()), links.chords.end());
+  return links;
 }
 
 // Removes the seeds marked in `drop` from every array of the state, keeping the others' order.
@@ -156,6 +170,42 @@ void DropSheetSeedsNear(State& s, size_t first, double clearance) {
   EraseSeeds(s, drop);
 }
 
+// Keeps the seed count after seeds were added on the feature chains: drops up to `count` sheet seeds (rank
+// 1) whose 6 nearest seeds are sheet seeds too, the most crowded first (smallest nearest-neighbour
+// distance, then index), never two that are among each other's 6 nearest, so that no hole wider than
+// about a spacing opens and no feature's neighbourhood thins. Returns the count dropped.
+size_t DropCrowdedSheetSeeds(State& s, size_t count) {
+  constexpr int kNeighbours = 6;
+  const size_t n = s.position.size();
+  const SeedIndex index(s.position);
+  std::vector<std::vector<int>> near(n);
+  std::vector<double> nearest(n, INFINITY);
+  std::vector<size_t> candidates;
+  for (size_t i = 0; i < n; ++i) {
+    if (s.rank[i].rank != 1) continue;
+    index.Nearest(s.position[i], kNeighbours + 1, near[i]);
+    bool sheet = near[i].size() > 1;
+    for (int j : near[i]) sheet = sheet && s.rank[static_cast<size_t>(j)].rank == 1;
+    if (!sheet) continue;
+    for (int j : near[i])
+      if (static_cast<size_t>(j) != i) nearest[i] = std::min(nearest[i], (s.position[static_cast<size_t>(j)] - s.position[i]).norm());
+    candidates.push_back(i);
+  }
+  std::sort(candidates.begin(), candidates.end(),
+            [&](size_t a, size_t b) { return nearest[a] != nearest[b] ? nearest[a] < nearest[b] : a < b; });
+  std::vector<char> drop(n, 0), blocked(n, 0);
+  size_t dropped = 0;
+  for (size_t i : candidates) {
+    if (dropped == count) break;
+    if (blocked[i]) continue;
+    drop[i] = 1;
+    ++dropped;
+    for (int j : near[i]) blocked[static_cast<size_t>(j)] = 1;
+  }
+  EraseSeeds(s, drop);
+  return dropped;
+}
+
 // Feature-seed thinning (SeedsBesideFeatures) judged at `where` (the seeds' positions or their step
 // targets), at the state's ranks; the marked seeds leave the state and, if given, `carried` (a per-seed
 // array alongside it). `where` may be s.position or *carried: it is read before either changes. Returns the
@@ -177,8 +227,13 @@ size_t ThinCrowded(State& s, const std::vector<Vec3>& where, const std::vector<d
   return dropped;
 }
 
-// Rounds of RefineFeatureChords: each halves the chords it refines, so their misfit falls by 4 per round.
-constexpr int kFeatureChordRounds = 4;
+// Rounds of RefineFeatureChains: each halves the chords it refines, so their misfit falls by 4 per round,
+// and takes a chain's end one spacing farther along its feature.
+constexpr int kFeatureChainRounds = 6;
+// ... before each outer iteration after the first, which moves the seeds anyway.
+constexpr int kFeatureChainRoundsInLoop = 2;
+// FindFeatureLinks' search radius, in mean spacings: chords longer than this are not seen as chords.
+constexpr double kFeatureLinkRadius = 2.5;
 // SeesTwoPlanes' contrast: between a uniform spread's 3.46 (one curved sheet) and the > 9 of two planes.
 constexpr double kCreaseContrast = 6.0;
 
@@ -423,45 +478,61 @@ class Optimizer {
     return moved;
   }
 
-  // Curved features (not in the paper; docs/optimize-seeds.md, "Curved features"). build-gvd joins
-  // consecutive seeds of a feature curve by a mesh edge, the chord; where the curve bends, the chord's
-  // midpoint lies off it by about h²/8R (h the chord, R the curve's radius), and the mesh cuts across the
-  // feature. Each round finds every chord — a curve seed and the nearest feature seed ahead of it and
-  // behind it along its tangent (and theirs), within 2.5 spacings — and moves a trial seed from the chord's
-  // midpoint onto the curve: projection, then the L1 step in its own cell among all seeds, which is what
-  // puts any seed onto a feature. The trial seed stays when it lands farther than `tolerance` from the
-  // midpoint, strictly between the chord's ends and on a feature (rank ≥ 2). Invariant after the last
-  // round that adds nothing: every chord's midpoint is within `tolerance` of the curve. Sheet seeds nearer
+  // Feature chains (not in the paper; docs/optimize-seeds.md, "Feature chains"). build-gvd joins
+  // consecutive seeds of a feature curve by a mesh edge, the chord, so the mesh traces the curve only where
+  // its chain of seeds is dense and on it. Each round finds the chain links (FindFeatureLinks) and moves a
+  // trial seed onto the curve where a link asks for one: from the midpoint of a chord longer than
+  // `max_gap` (a gap in the chain) or, with `bend_tol` > 0, of any chord (its midpoint may lie off a bent
+  // curve by about h²/8R); and from one spacing beyond a chain's end along its tangent (the chain may stop
+  // short of where the feature goes on). The move is projection, then the L1 step in the trial's own cell
+  // among all seeds, which is what puts any seed onto a feature. A trial seed stays when it lands on a
+  // feature and is not crowded by one: for a chord, on a curve (rank 2, tangent along the chord) between 1/4
+  // and 3/4 of it, off it by at most a quarter chord (a bend, not a jump to another feature) and, unless the
+  // chord is a gap, by more than `bend_tol`; for an end, 0.5–1.6 spacings ahead on a curve running that way,
+  // or on a corner (rank 3). Invariant after a round that adds nothing: every chord of at least 2.5
+  // clearances is at most `max_gap` long and has its midpoint within `bend_tol` of its curve, and one
+  // spacing beyond every chain end there is no further curve for the L1 step to find. Sheet seeds nearer
   // than `clearance` to an added seed are dropped, as the feature-seed thinning does. Returns the count added.
-  size_t RefineFeatureChords(State& s, double tolerance, double clearance, int rounds) {
+  size_t RefineFeatureChains(State& s, double bend_tol, double max_gap, double clearance, int rounds) {
     const size_t n0 = s.position.size();
     size_t added = 0, last_added = 0;
+    const double spacing = MeanSpacing(s.position);
     for (int round = 0; round < rounds; ++round) {
       Analyze(s);
       const size_t n = s.position.size();
-      const double spacing = MeanSpacing(s.position);
       const std::vector<Vec3> tangent = Tangents(s);
-      std::vector<std::pair<int, int>> chords = FeatureChords(s, tangent, spacing);
-      // After the first round only chords with a seed added in the last round can have changed.
-      if (round > 0)
-        chords.erase(std::remove_if(chords.begin(), chords.end(),
-                                    [&](const auto& c) { return static_cast<size_t>(c.second) < n - last_added; }),
-                     chords.end());
+      FeatureLinks links = FindFeatureLinks(s, tangent, kFeatureLinkRadius * spacing);
+      // After the first round only links with a seed added in the last round can have changed.
+      const size_t fresh = round > 0 ? n - last_added : 0;
+      struct Trial {
+        int a = -1, b = -1;  // a chord's ends, or (a, -1): a chain end at seed a
+        Vec3 start = Vec3::Zero(), direction = Vec3::Zero();
+      };
+      std::vector<Trial> trials;
+      for (const auto& [a, b] : links.chords) {
+        if (static_cast<size_t>(b) < fresh) continue;
+        const Vec3 &pa = s.position[static_cast<size_t>(a)], &pb = s.position[static_cast<size_t>(b)];
+        const double h = (pb - pa).norm();
+        if (h < 2.5 * clearance || (bend_tol <= 0.0 && !(max_gap > 0.0 && h > max_gap))) continue;
+        trials.push_back({a, b, 0.5 * (pa + pb), Vec3::Zero()});
+      }
+      if (max_gap > 0.0)
+        for (const auto& [a, direction] : links.ends)
+          if (static_cast<size_t>(a) >= fresh)
+            trials.push_back({a, -1, s.position[static_cast<size_t>(a)] + spacing * direction, direction});
       last_added = 0;
-      if (chords.empty()) break;
-      std::vector<Vec3> midpoint(chords.size());
-      for (size_t k = 0; k < chords.size(); ++k)
-        midpoint[k] = 0.5 * (s.position[static_cast<size_t>(chords[k].first)] + s.position[static_cast<size_t>(chords[k].second)]);
-      std::vector<Vec3> trial_points = midpoint;
+      if (trials.empty()) break;
+      std::vector<Vec3> trial_points(trials.size());
+      for (size_t k = 0; k < trials.size(); ++k) trial_points[k] = trials[k].start;
       const ProjectionResult projected = ProjectToZeroSet(udf_, trial_points, projection_, Monitor::Null());
       State trial = s;
-      std::vector<size_t> trial_chord;
-      for (size_t k = 0; k < chords.size(); ++k) {
+      std::vector<size_t> trial_of;
+      for (size_t k = 0; k < trials.size(); ++k) {
         if (!projected.converged[k]) continue;
         trial.position.push_back(trial_points[k]);
         trial.udf.push_back(projected.distance[k]);
         trial.normal.push_back(projected.gradient[k]);
-        trial_chord.push_back(k);
+        trial_of.push_back(k);
       }
       trial.rank.resize(trial.position.size());
       trial.space.resize(trial.position.size());
@@ -474,18 +545,34 @@ class Optimizer {
       const SeedIndex index(s.position);
       std::vector<int> near;
       for (size_t t = 0; t < landed.size(); ++t) {
-        const auto [a, b] = chords[trial_chord[t]];
-        const Vec3 &pa = s.position[static_cast<size_t>(a)], &pb = s.position[static_cast<size_t>(b)];
-        const double h = (pb - pa).norm(), u = (landed[t] - pa).dot(pb - pa) / (h * h);
-        if (!r.converged[t] || trial.rank[n + t].rank != 2 || u < 0.25 || u > 0.75) continue;
-        // On the chord's own curve: running along the chord, and off it by a bend (at most a quarter chord), not
-        // a jump to another feature; and not splitting chords shorter than twice the feature-seed clearance.
-        const Vec3 t_new = trial.space[n + t].basis.col(0);
-        const double off = (landed[t] - midpoint[trial_chord[t]]).norm();
-        if (off <= tolerance || off > 0.25 * h || h < 2.5 * clearance || std::abs(t_new.dot(pb - pa)) < 0.8 * h) continue;
-        index.WithinRadius(landed[t], 0.2 * h, near);
+        const Trial& c = trials[trial_of[t]];
+        const int rank = trial.rank[n + t].rank;
+        if (!r.converged[t] || rank < 2) continue;
+        const Vec3 t_new = rank == 2 ? Vec3(trial.space[n + t].basis.col(0)) : Vec3::Zero();
+        const Vec3& pa = s.position[static_cast<size_t>(c.a)];
+        double crowd_radius = 0.0;
+        if (c.b >= 0) {
+          const Vec3& pb = s.position[static_cast<size_t>(c.b)];
+          const double h = (pb - pa).norm(), u = (landed[t] - pa).dot(pb - pa) / (h * h);
+          const double off = (landed[t] - c.start).norm();
+          const bool gap = max_gap > 0.0 && h > max_gap;
+          if (rank != 2 || u < 0.25 || u > 0.75 || off > 0.25 * h || (!gap && off <= bend_tol) ||
+              std::abs(t_new.dot(pb - pa)) < 0.8 * h)
+            continue;
+          crowd_radius = 0.2 * h;
+        } else {
+          const Vec3 e = landed[t] - pa;
+          const double ahead = e.dot(c.direction);
+          if (ahead < 0.5 * spacing || ahead > 1.6 * spacing || ahead < 0.8 * e.norm()) continue;
+          if (rank == 2 && std::abs(t_new.dot(e)) < 0.8 * e.norm()) continue;
+          crowd_radius = 0.5 * spacing;
+        }
+        // Not beside a feature seed, nor beside a trial seed kept in this round (two ends facing each other).
+        index.WithinRadius(landed[t], crowd_radius, near);
         bool crowded = false;
         for (int j : near) crowded = crowded || s.rank[static_cast<size_t>(j)].rank >= 2;
+        for (size_t k = n; k < s.position.size() && !crowded; ++k)
+          crowded = (s.position[k] - landed[t]).norm() < crowd_radius;
         if (crowded) continue;
         s.position.push_back(landed[t]);
         s.udf.push_back(r.distance[t]);
@@ -765,6 +852,24 @@ SeedCloud OptimizeSeeds(const Udf& udf, const SeedCloud& input, const OptimizeSe
   RepulsionOptions repulsion;
   repulsion.max_iterations = options.lbfgs_max_iters;
   repulsion.max_step = options.max_step;
+  // Step 8 (docs/optimize-seeds.md, "Feature chains"): seeds added on the feature chains and the sheet seeds
+  // beside them dropped; keep_count: as many more crowded sheet seeds dropped as keep the count.
+  const bool chains = (options.feature_chord_tol > 0.0 || options.feature_gap_max > 0.0) && options.max_outer_iters > 0;
+  struct ChainFill {
+    size_t added = 0, dropped = 0;
+  };
+  auto fill_chains = [&](int rounds, bool keep_count) {
+    ChainFill fill;
+    const double spacing = opt.MeanSpacing(s.position);
+    const size_t before = s.position.size();
+    fill.added = opt.RefineFeatureChains(s, options.feature_chord_tol * spacing, options.feature_gap_max * spacing,
+                                         options.feature_clearance * spacing, rounds);
+    if (fill.added == 0) return fill;
+    if (keep_count && s.position.size() > before) DropCrowdedSheetSeeds(s, s.position.size() - before);
+    fill.dropped = before + fill.added - s.position.size();
+    opt.Analyze(s);
+    return fill;
+  };
   double previous_sigma = 0.0, previous_cv = cv_in;
   for (int outer = 1; outer <= options.max_outer_iters; ++outer) {
     const auto outer_start = Clock::now();
@@ -772,6 +877,13 @@ SeedCloud OptimizeSeeds(const Udf& udf, const SeedCloud& input, const OptimizeSe
     report.iteration = outer;
     {
       Task task(monitor, "outer iteration " + std::to_string(outer), static_cast<uint64_t>(options.max_inner_iters + 1));
+      // The chains filled before every outer iteration but the first, keeping the count: this iteration's L1
+      // step and repulsion then spread the seeds around the added ones and over the dropped ones' holes.
+      if (chains && outer > 1) {
+        const ChainFill fill = fill_chains(kFeatureChainRoundsInLoop, true);
+        monitor.Debug(std::to_string(fill.added) + " seeds added on feature chains, " + std::to_string(fill.dropped) +
+                      " sheet seeds dropped");
+      }
       // Alg. 1 line 3: the L1 tangent step, then back onto the zero set.
       const auto l1_t0 = Clock::now();
       const CellSamples cells = opt.Analyze(s);
@@ -877,17 +989,12 @@ SeedCloud OptimizeSeeds(const Udf& udf, const SeedCloud& input, const OptimizeSe
   if (crowded > 0)
     monitor.Info(std::to_string(crowded) + Format(" seeds dropped by the feature-seed thinning (nearer than %.2f x the "
                                                   "mean spacing to a kept curve or corner seed)", options.feature_clearance));
-  if (options.feature_chord_tol > 0.0 && options.max_outer_iters > 0) {
-    const double spacing = opt.MeanSpacing(s.position);
-    const size_t before = s.position.size();
-    const size_t added = opt.RefineFeatureChords(s, options.feature_chord_tol * spacing,
-                                                 options.feature_clearance * spacing, kFeatureChordRounds);
-    if (added > 0) {
-      opt.Analyze(s);
-      monitor.Info(std::to_string(added) + " seeds added where a feature curve bends away from the chord between two of "
-                   "its seeds by more than " + Format("%.3g x the mean spacing; ", options.feature_chord_tol) +
-                   std::to_string(before + added - s.position.size()) + " sheet seeds beside them dropped");
-    }
+  if (chains) {
+    const ChainFill fill = fill_chains(kFeatureChainRounds, false);
+    if (fill.added > 0)
+      monitor.Info(std::to_string(fill.added) + " seeds added on feature chains (gaps, ends" +
+                   (options.feature_chord_tol > 0.0 ? ", bends)" : ")") + "; " + std::to_string(fill.dropped) +
+                   " sheet seeds beside them dropped");
   }
   if (const SamplePool* pool = opt.pool())
     monitor.Info("sample pool: " + std::to_string(pool->points()) + " points in " + std::to_string(pool->buckets()) +
