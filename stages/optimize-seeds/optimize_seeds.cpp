@@ -989,6 +989,7 @@ SeedCloud OptimizeSeeds(const Udf& udf, const SeedCloud& input, const OptimizeSe
   if (crowded > 0)
     monitor.Info(std::to_string(crowded) + Format(" seeds dropped by the feature-seed thinning (nearer than %.2f x the "
                                                   "mean spacing to a kept curve or corner seed)", options.feature_clearance));
+  // The chains filled once more at the final positions, so that the invariant holds for the output.
   if (chains) {
     const ChainFill fill = fill_chains(kFeatureChainRounds, false);
     if (fill.added > 0)

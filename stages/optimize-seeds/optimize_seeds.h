@@ -61,9 +61,9 @@ struct OptimizeSeedsOptions {
   double feature_chord_tol = 0.0;
   /// Where two consecutive seeds of a feature chain lie farther apart than this × the mean spacing, a seed
   /// is added on the curve between them, and a chain's end is extended one spacing along its curve while
-  /// the L1 step finds the curve there (--feature-gap-max; 0: never; at most 2.5, the chain search radius).
-  /// Not in the paper, see docs/optimize-seeds.md ("Feature chains").
-  double feature_gap_max = 1.5;
+  /// the L1 step finds the curve there (--feature-gap-max; 0: never, the default; 1–2.5, the chain search
+  /// radius). Not in the paper, see docs/optimize-seeds.md ("Feature chains", also for why it is off).
+  double feature_gap_max = 0.0;
   double max_step = 0.5;          ///< trust region: a repulsion round moves a seed at most this many σ (--max-step)
   double repulsion_cutoff = 3.0;  ///< neighbours interact within this many σ (kernel 1.1e-2 at 3σ) (--repulsion-cutoff)
   double l1_tol_rel = 1e-6;       ///< L1 step solved to this position accuracy, relative to the diagonal (--l1-tol-rel)
@@ -126,11 +126,11 @@ std::vector<char> SeedsBesideFeatures(const std::vector<Vec3>& position, const s
 /// seed farther than move_tol·σ, or after max_outer_iters. Then feature_steps L1 steps of the feature seeds
 /// alone put seeds that slid along a curved feature back onto it; before each move, seeds whose targets
 /// crowd a feature seed's are dropped (SeedsBesideFeatures, by the misfit at the target). Then the
-/// ranks are recomputed at the final positions and crowding seeds dropped again. After every outer
-/// iteration and at the end, seeds are added on the feature chains where two consecutive seeds lie more than
+/// ranks are recomputed at the final positions and crowding seeds dropped again. With feature_gap_max or
+/// feature_chord_tol, before outer iterations 2, 3, … (dropping as many crowded sheet seeds) and at the
+/// end, seeds are added on the feature chains where two consecutive seeds lie more than
 /// feature_gap_max spacings apart, beyond a chain's ends while the L1 step finds its curve there, and
-/// (feature_chord_tol) where a chord leaves its curve; as many sheet seeds are dropped (the count stays), and
-/// at the end one repulsion round of the sheet seeds spreads them again.
+/// (feature_chord_tol) where a chord leaves its curve.
 /// \param udf           the field (thread-safe batched queries); lengths are relative to its domain diagonal
 /// \param input         seeds (only positions are used); at least 2 distinct ones
 /// \param options       see OptimizeSeedsOptions; checked first (UsageError)
