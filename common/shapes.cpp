@@ -134,11 +134,11 @@ class Torus : public Primitive {
   double R_, r_;
 };
 
-// A closed polyhedron given by its triangles: the closest point over them (TriangleBvh), the normal of
-// the closest triangle.
+// A closed polyhedron given by its triangles: the closest point over them (TriangleBvh, which keeps its own
+// packed copy of the triangles), the normal of the closest triangle.
 class Polyhedron : public Primitive {
  public:
-  explicit Polyhedron(TriangleMesh mesh) : mesh_(std::move(mesh)), bvh_(mesh_.vertices, mesh_.faces) {}
+  explicit Polyhedron(const TriangleMesh& mesh) : bvh_(mesh.vertices, mesh.faces) {}
   Vec3 ClosestPoint(const Vec3& p, Vec3* normal) const override {
     const TriangleBvh::Hit hit = bvh_.Closest(p);
     *normal = bvh_.FaceNormal(hit.face);
@@ -146,7 +146,6 @@ class Polyhedron : public Primitive {
   }
 
  private:
-  TriangleMesh mesh_;
   TriangleBvh bvh_;
 };
 

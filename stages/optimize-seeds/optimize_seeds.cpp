@@ -15,6 +15,10 @@
 #include "stages/optimize-seeds/voronoi_cells.h"
 
 namespace voroudf {
+namespace {
+// FindFeatureLinks' search radius, in mean spacings: chords longer than this are not seen as chords.
+constexpr double kFeatureLinkRadius = 2.5;
+}  // namespace
 
 void OptimizeSeedsOptions::Check() const {
   if (samples_per_cell < 3 || samples_per_cell > 100000) throw UsageError("--samples-per-cell must be in [3, 100000]");
@@ -43,8 +47,8 @@ void OptimizeSeedsOptions::Check() const {
   if (!(feature_clearance >= 0.0 && feature_clearance <= 1.0)) throw UsageError("--feature-clearance must be in [0, 1]");
   if (feature_steps < 0) throw UsageError("--feature-steps must be at least 0");
   if (!(feature_chord_tol >= 0.0 && feature_chord_tol <= 1.0)) throw UsageError("--feature-chord-tol must be in [0, 1]");
-  if (!(feature_gap_max == 0.0 || (feature_gap_max >= 1.0 && feature_gap_max <= 2.5)))  // 2.5: kFeatureLinkRadius
-    throw UsageError("--feature-gap-max must be 0 or in [1, 2.5]");
+  if (!(feature_gap_max == 0.0 || (feature_gap_max >= 1.0 && feature_gap_max <= kFeatureLinkRadius)))
+    throw UsageError("--feature-gap-max must be 0 or in [1, 2.5] (no chain link is sought beyond 2.5 spacings)");
   if (sigma_max_spacing > 0.0 && sigma_min_spacing > sigma_max_spacing)
     throw UsageError("--sigma-min-spacing must not exceed --sigma-max-spacing");
   if (!(repulsion_cutoff >= 1.0 && repulsion_cutoff <= 10.0)) throw UsageError("--repulsion-cutoff must be in [1, 10]");
@@ -232,8 +236,6 @@ size_t ThinCrowded(State& s, const std::vector<Vec3>& where, const std::vector<d
 constexpr int kFeatureChainRounds = 6;
 // ... before each outer iteration after the first, which moves the seeds anyway.
 constexpr int kFeatureChainRoundsInLoop = 2;
-// FindFeatureLinks' search radius, in mean spacings: chords longer than this are not seen as chords.
-constexpr double kFeatureLinkRadius = 2.5;
 // SeesTwoPlanes' contrast: between a uniform spread's 3.46 (one curved sheet) and the > 9 of two planes.
 constexpr double kCreaseContrast = 6.0;
 
@@ -501,7 +503,7 @@ class Optimizer {
       Analyze(s);
       const size_t n = s.position.size();
       const std::vector<Vec3> tangent = Tangents(s);
-      FeatureLinks links = FindFeatureLinks(s, tangent, kFeatureLinkRadius * spacing);
+      const FeatureLinks links = FindFeatureLinks(s, tangent, kFeatureLinkRadius * spacing);
       // After the first round only links with a seed added in the last round can have changed.
       const size_t fresh = round > 0 ? n - last_added : 0;
       struct Trial {
@@ -993,9 +995,10 @@ SeedCloud OptimizeSeeds(const Udf& udf, const SeedCloud& input, const OptimizeSe
   if (chains) {
     const ChainFill fill = fill_chains(kFeatureChainRounds, false);
     if (fill.added > 0)
-      monitor.Info(std::to_string(fill.added) + " seeds added on feature chains (gaps, ends" +
-                   (options.feature_chord_tol > 0.0 ? ", bends)" : ")") + "; " + std::to_string(fill.dropped) +
-                   " sheet seeds beside them dropped");
+      monitor.Info(std::to_string(fill.added) + " seeds added on feature chains (" +
+                   (options.feature_gap_max > 0.0 ? (options.feature_chord_tol > 0.0 ? "gaps, ends, bends" : "gaps, ends")
+                                                  : "bends") +
+                   "); " + std::to_string(fill.dropped) + " sheet seeds beside them dropped");
   }
   if (const SamplePool* pool = opt.pool())
     monitor.Info("sample pool: " + std::to_string(pool->points()) + " points in " + std::to_string(pool->buckets()) +
