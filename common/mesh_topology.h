@@ -3,6 +3,7 @@
 // boundary and non-manifold edges and vertices, components, Euler characteristic, welding. Written by
 // hand because OpenMesh's halfedge structure cannot hold an edge with three or more faces (DESIGN.md).
 #include <array>
+#include <cstddef>
 #include <cstdint>
 #include <unordered_map>
 #include <vector>
@@ -17,6 +18,16 @@ inline Edge MakeEdge(int a, int b) { return a < b ? Edge{a, b} : Edge{b, a}; }
 inline uint64_t EdgeKey(const Edge& e) {
   return (static_cast<uint64_t>(static_cast<uint32_t>(e[0])) << 32) | static_cast<uint32_t>(e[1]);
 }
+
+/// A hash of a vertex triple (as stored: callers that mean "the same three vertices" sort them first).
+struct TriHash {
+  size_t operator()(const Tri& t) const {
+    uint64_t h = static_cast<uint32_t>(t[0]);
+    h = h * 0x9E3779B97F4A7C15ull ^ static_cast<uint32_t>(t[1]);
+    h = h * 0x9E3779B97F4A7C15ull ^ static_cast<uint32_t>(t[2]);
+    return static_cast<size_t>(h ^ (h >> 29));
+  }
+};
 
 /// Every undirected edge of the mesh with the faces that contain it, in a deterministic order
 /// (edges sorted by (v0, v1); faces in increasing index).

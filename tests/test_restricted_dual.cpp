@@ -1,10 +1,13 @@
 // The dual as a subcomplex of the seeds' Delaunay triangulation (stages/build-gvd/restricted_dual.h):
 // properties that a wrong construction breaks. A junction of 5-6 regions gives a disc, never a tetrahedron;
 // randomly perturbed well-spaced seeds on the sphere and the torus give closed 2-manifolds of chi 2 and 0;
-// two planes crossing at random angles keep exactly their crossing line as branching edges.
+// two planes crossing at random angles keep exactly their crossing line as branching edges; where sheets
+// cross at a gap of the chain of curve seeds, each sheet keeps its triangle on the chain's link.
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <map>
+#include <set>
 
 #include "common/mesh_topology.h"
 #include "common/rng.h"
@@ -67,6 +70,116 @@ TEST(RestrictedDual, ATriangleSpanningASeedOnItsEdgeIsNotKept) {
   const std::vector<Tri> out =
       LocallyDelaunayTriples(p, std::vector<Vec3>(6, Vec3(0, 0, 1)), std::vector<uint8_t>(6, 1), witnessed, 25.0, nullptr);
   EXPECT_EQ(out, (std::vector<Tri>{{1, 2, 5}, {2, 3, 5}, {0, 1, 5}, {3, 4, 5}})) << "and (1, 2, 3) is collinear";
+}
+
+// Two curve seeds 0, 1 on the line where the planes z = 0 and x = 0 cross, and a sheet seed on each of the
+// four half-planes around it, each moved by up to `jitter` (a chain with a gap: the six regions nearly meet
+// at one point, so the dense samples witness nearly every triple); then the chain's next seeds on either
+// side, 6 before 0 and 7 after 1.
+std::vector<Vec3> CrossingCluster(double jitter, uint64_t seed) {
+  const std::vector<Vec3> base = {{0, 0, 0},   {0, 1, 0},      {0.5, 0.5, 0}, {-0.5, 0.5, 0},
+                                  {0, 0.5, 0.5}, {0, 0.5, -0.5}, {0, -1, 0},    {0, 2, 0}};
+  std::vector<Vec3> p;
+  for (size_t i = 0; i < base.size(); ++i) {
+    Rng rng(seed, i);
+    Vec3 q = base[i];
+    for (int c = 0; c < 3; ++c)
+      if (base[i][c] != 0.0 || (i < 2 && c == 1)) q[c] += jitter * rng.Uniform(-1, 1);  // stay on the sheet or line
+    p.push_back(q);
+  }
+  return p;
+}
+
+// Every triple of the six seeds around the gap, and the triangles of each half-plane on the chain beyond it.
+std::vector<Tri> CrossingTriples() {
+  std::vector<Tri> t = AllTriples(6);
+  for (int s = 2; s < 6; ++s) {
+    t.push_back({0, s, 6});
+    t.push_back({1, s, 7});
+  }
+  return t;
+}
+
+std::map<Edge, int> TriplesPerEdge(const std::vector<Tri>& triples) {
+  std::map<Edge, int> count;
+  for (const Tri& t : triples)
+    for (int k = 0; k < 3; ++k) ++count[MakeEdge(t[k], t[(k + 1) % 3])];
+  return count;
+}
+
+TEST(ChainLinks, WhereSheetsCrossAtAGapOfTheChainEachSheetKeepsItsTriangleOnTheLink) {
+  const std::vector<uint8_t> is_curve = {1, 1, 0, 0, 0, 0, 1, 1};
+  for (uint64_t seed = 1; seed <= 10; ++seed) {
+    const std::vector<Vec3> p = CrossingCluster(0.05, seed);
+    const std::vector<Tri> all = CrossingTriples();
+    ChainLinkStats stats;
+    const std::vector<Tri> kept = KeepChainLinks(p, is_curve, all, &stats);
+    EXPECT_EQ(stats.links, 3u);
+    const std::set<Tri> k(kept.begin(), kept.end());
+    for (int s = 2; s < 6; ++s) EXPECT_TRUE(k.count({0, 1, s})) << "the link's triangle on half-plane " << s;
+    for (const Tri& t : kept) {
+      const int curve = (t[0] < 2) + (t[1] < 2) + (t[2] < 2);
+      EXPECT_FALSE(curve == 1 && t[2] < 6) << t[0] << t[1] << t[2] << ": one end of the link and two half-planes";
+    }
+    // No edge with two or more triples is left with one: nothing is opened.
+    const auto after = TriplesPerEdge(kept);
+    for (const auto& [e, n] : TriplesPerEdge(all)) {
+      const auto it = after.find(e);
+      EXPECT_TRUE(n == 1 || (it != after.end() && it->second != 1)) << e[0] << "-" << e[1];
+    }
+    EXPECT_EQ(kept.size(), 16u) << "4 on the link, 8 on the chain beyond, 4 among the sheet seeds for thin-mesh";
+  }
+}
+
+TEST(ChainLinks, SeedsOnOneSideOfTheLinkOrNoChainAreLeftToTheCharts) {
+  // A closed tetrahedron of two seeds on a crease and two on the same face: the triangulation of that face
+  // is the chart's decision (LocallyDelaunayTriples), not the link's.
+  const std::vector<Vec3> p = {{0, 0, 0}, {0, 1, 0}, {0.4, 0.3, 0}, {0.5, 0.8, 0.05}};
+  const std::vector<Tri> tet = AllTriples(4);
+  EXPECT_EQ(KeepChainLinks(p, {1, 1, 0, 0}, tet, nullptr), tet);
+  // Without curve seeds there is no link: the crossing cluster is left as it is.
+  const std::vector<Tri> all = CrossingTriples();
+  ChainLinkStats stats;
+  EXPECT_EQ(KeepChainLinks(CrossingCluster(0.05, 1), std::vector<uint8_t>(8, 0), all, &stats), all);
+  EXPECT_EQ(stats.links, 0u);
+  // Three curve seeds in a row: the outer two are no link (the middle one lies between them).
+  const std::vector<Vec3> row = {{0, 0, 0}, {0, 1, 0}, {0, 2, 0}, {0.5, 1, 0}};
+  KeepChainLinks(row, {1, 1, 1, 0}, {{0, 1, 3}, {0, 2, 3}, {1, 2, 3}}, &stats);
+  EXPECT_EQ(stats.links, 2u);
+}
+
+// A flat strip: curve seeds 0-4 on the x axis, a sheet seed above and one below each link, triangulated.
+std::vector<Tri> StripTriangles() {
+  std::vector<Tri> t;
+  for (int i = 0; i < 4; ++i) {
+    t.push_back({i, i + 1, 5 + i});
+    t.push_back({i, i + 1, 9 + i});
+  }
+  for (int i = 0; i < 3; ++i) {
+    t.push_back({i + 1, 5 + i, 6 + i});
+    t.push_back({i + 1, 9 + i, 10 + i});
+  }
+  return t;
+}
+
+TEST(ChainLinks, ATriangleAlongTheChainJumpingACurveSeedIsDropped) {
+  std::vector<Vec3> p;
+  for (int i = 0; i < 5; ++i) p.push_back({double(i), 0, 0});
+  for (int i = 0; i < 4; ++i) p.push_back({i + 0.5, 0.8, 0});
+  for (int i = 0; i < 4; ++i) p.push_back({i + 0.5, -0.8, 0});
+  std::vector<uint8_t> is_curve(p.size(), 0);
+  std::fill(is_curve.begin(), is_curve.begin() + 5, 1);
+  std::vector<Tri> with_sliver = StripTriangles();
+  with_sliver.push_back({1, 2, 3});  // seeds 1 and 3 jump over 2
+  ChainLinkStats stats;
+  EXPECT_EQ(KeepChainLinks(p, is_curve, with_sliver, &stats), StripTriangles());
+  EXPECT_EQ(stats.links, 4u);
+  EXPECT_EQ(stats.jumps, 1u);
+  // Where the chain turns by 60 degrees at the middle seed (a corner of the surface), the triangle of the
+  // three is a face: kept.
+  const std::vector<Vec3> corner = {{-1, 0, 0}, {0, 0, 0}, {0.5, std::sqrt(0.75), 0}};
+  EXPECT_EQ(KeepChainLinks(corner, {1, 1, 1}, {{0, 1, 2}}, &stats), (std::vector<Tri>{{0, 1, 2}}));
+  EXPECT_EQ(stats.jumps, 0u);
 }
 
 // `base` (seeds spread evenly on a shape), each moved by up to `perturb` x the spacing along the surface and projected back.

@@ -559,6 +559,14 @@ GvdResult BuildGvd(const Udf& udf, const SeedCloud& seeds, const BuildGvdOptions
     faces = LocallyDelaunayTriples(seeds.position, seed_normal, on_sheet, faces, options.chart_angle_deg, &rd);
     monitor.Info(Format("locally Delaunay: %zu of %zu witnessed triples kept (%zu collinear)", rd.kept, rd.witnessed,
                         rd.degenerate));
+    if (options.chain_links) {
+      std::vector<uint8_t> is_curve(num_seeds);
+      for (size_t i = 0; i < num_seeds; ++i) is_curve[i] = IsCurveSeed(seeds, i);
+      ChainLinkStats cl;
+      faces = KeepChainLinks(seeds.position, is_curve, faces, &cl);
+      monitor.Info(Format("chain links: %zu between curve seeds; %zu jumps over a curve seed and the crossings dropped %zu triples",
+                          cl.links, cl.jumps, cl.dropped));
+    }
   }
   stats.triangles = faces.size();
   result.thick.vertices = seeds.position;

@@ -47,6 +47,9 @@ struct BuildGvdOptions {
   /// --region-flatness: with --dual delaunay, a seed's region is a sheet (its normal counts for charts) when
   /// its samples' least spread is at most this x their largest.
   double region_flatness = 0.15;
+  /// --chain-links: with --dual delaunay, drop the triples that jump a seed of a feature chain or cut across
+  /// it where sheets cross (restricted_dual.h, KeepChainLinks).
+  bool chain_links = true;
   uint64_t seed = 0;           ///< RNG seed of the dense samples (--seed)
   double proj_tol_rel = 1e-5;  ///< samples converge once d < proj_tol_rel * diagonal (--proj-tol-rel)
   int proj_max_iters = 50;     ///< projection steps before a sample is dropped (--proj-max-iters)

@@ -39,6 +39,9 @@ int main(int argc, char** argv) {
                  "with --dual delaunay: a region flatter than this (least / largest spread) is a sheet");
   app.add_option("--chart-angle", options.chart_angle_deg,
                  "with --dual delaunay: seeds whose normals agree within this angle (deg) share a chart");
+  app.add_option("--chain-links", options.chain_links,
+                 "with --dual delaunay: drop the triangles that jump a seed of a feature chain or cut across it "
+                 "where sheets cross (true/false)");
   app.add_option("--proj-tol-rel", options.proj_tol_rel, "projection tolerance on d, relative to the diagonal");
   app.add_option("--proj-max-iters", options.proj_max_iters, "projection steps before a sample is dropped");
   app.add_option("--proj-floor-rel", options.proj_floor_rel, voroudf::kProjFloorRelHelp);

@@ -7,6 +7,11 @@
 #include <cmath>
 #include <cstdint>
 #include <iterator>
+#include <unordered_map>
+#include <unordered_set>
+#include <utility>
+
+#include "common/mesh_topology.h"
 
 namespace voroudf {
 namespace {
@@ -47,16 +52,10 @@ Vec3 ChartNormal(const std::array<int, 4>& id, const std::vector<Vec3>& seeds, c
   return plane;
 }
 
-}  // namespace
-
-std::vector<Tri> LocallyDelaunayTriples(const std::vector<Vec3>& seeds, const std::vector<Vec3>& normals,
-                                        const std::vector<uint8_t>& on_sheet, const std::vector<Tri>& witnessed,
-                                        double chart_angle_deg, RestrictedDualStats* stats_out) {
-  RestrictedDualStats stats;
-  stats.witnessed = witnessed.size();
-  // Geodesic neighbours: the seeds each seed shares a witnessed triple with.
-  std::vector<std::vector<int>> neighbours(seeds.size());
-  for (const Tri& t : witnessed)
+// Geodesic neighbours: per seed, the seeds it shares a triple with, sorted.
+std::vector<std::vector<int>> GeodesicNeighbours(size_t num_seeds, const std::vector<Tri>& triples) {
+  std::vector<std::vector<int>> neighbours(num_seeds);
+  for (const Tri& t : triples)
     for (int k = 0; k < 3; ++k)
       for (int m = 0; m < 3; ++m)
         if (m != k) neighbours[static_cast<size_t>(t[k])].push_back(t[m]);
@@ -64,6 +63,188 @@ std::vector<Tri> LocallyDelaunayTriples(const std::vector<Vec3>& seeds, const st
     std::sort(n.begin(), n.end());
     n.erase(std::unique(n.begin(), n.end()), n.end());
   }
+  return neighbours;
+}
+
+Tri SortedTri(int a, int b, int c) {
+  Tri t{a, b, c};
+  std::sort(t.begin(), t.end());
+  return t;
+}
+
+// Seeds a and b lie on two sides of a link (two faces of a crease, two sheets where sheets cross, or the
+// two sides of a sheet's curve) when the directions from the link to them, across it, differ by more than
+// this: on one side of it (one face, a curved one included) they lie within a few tens of degrees.
+constexpr double kLinkSideAngleDeg = 60.0;
+
+// The chain links among the curve seeds (KeepChainLinks): geodesic neighbours with no common curve neighbour
+// strictly inside the sphere on their segment.
+std::vector<std::array<int, 2>> ChainLinks(const std::vector<Vec3>& seeds, const std::vector<uint8_t>& is_curve,
+                                           const std::vector<std::vector<int>>& neighbours) {
+  std::vector<std::array<int, 2>> links;
+  std::vector<int> common;
+  for (size_t c = 0; c < seeds.size(); ++c) {
+    if (!is_curve[c]) continue;
+    for (int d : neighbours[c]) {
+      if (d <= static_cast<int>(c) || !is_curve[static_cast<size_t>(d)]) continue;
+      const auto& nd = neighbours[static_cast<size_t>(d)];
+      common.clear();
+      std::set_intersection(neighbours[c].begin(), neighbours[c].end(), nd.begin(), nd.end(),
+                            std::back_inserter(common));
+      const Vec3 &pc = seeds[c], &pd = seeds[static_cast<size_t>(d)];
+      bool between = false;
+      for (int w : common) {
+        const Vec3& pw = seeds[static_cast<size_t>(w)];
+        between = between || (is_curve[static_cast<size_t>(w)] && (pc - pw).dot(pd - pw) < 0.0);
+      }
+      if (!between) links.push_back({static_cast<int>(c), d});
+    }
+  }
+  return links;
+}
+
+// The triples being decided, with their live count per edge.
+struct LiveTriples {
+  std::unordered_set<Tri, TriHash> present;
+  std::unordered_map<uint64_t, int> per_edge;
+
+  explicit LiveTriples(const std::vector<Tri>& triples) : present(triples.begin(), triples.end()) {
+    for (const Tri& t : triples)
+      for (int k = 0; k < 3; ++k) ++per_edge[EdgeKey(MakeEdge(t[k], t[(k + 1) % 3]))];
+  }
+  bool Has(int a, int b, int c) const { return present.count(SortedTri(a, b, c)) > 0; }
+  int OnEdge(int a, int b) const {
+    const auto it = per_edge.find(EdgeKey(MakeEdge(a, b)));
+    return it == per_edge.end() ? 0 : it->second;
+  }
+  // The present triples on edge ab: their third seeds, from the geodesic neighbours.
+  std::vector<int> Thirds(int a, int b, const std::vector<std::vector<int>>& neighbours) const {
+    std::vector<int> third;
+    const auto &na = neighbours[static_cast<size_t>(a)], &nb = neighbours[static_cast<size_t>(b)];
+    std::set_intersection(na.begin(), na.end(), nb.begin(), nb.end(), std::back_inserter(third));
+    third.erase(std::remove_if(third.begin(), third.end(), [&](int x) { return !Has(a, b, x); }), third.end());
+    return third;
+  }
+  // Drops `drop` unless that leaves an edge with one triple that had more: no new boundary edge.
+  bool DropIfClosed(const std::vector<Tri>& drop) {
+    std::unordered_map<uint64_t, int> after;
+    for (const Tri& t : drop)
+      for (int k = 0; k < 3; ++k) {
+        const uint64_t e = EdgeKey(MakeEdge(t[k], t[(k + 1) % 3]));
+        after.emplace(e, per_edge.at(e));
+        --after[e];
+      }
+    for (const auto& [e, n] : after)
+      if (n == 1) return false;
+    for (const Tri& t : drop) present.erase(t);
+    for (const auto& [e, n] : after) per_edge[e] = n;
+    return true;
+  }
+};
+
+// A chain goes on through a curve seed c where its links to x and y make an angle above this at c; a
+// smaller angle is a corner of the surface (two creases) or a bend, and the triangle (x, c, y) may be a face.
+const double kJumpMaxCos = std::cos(135.0 * M_PI / 180.0);
+
+// The chain links, as a set and per seed.
+struct Chain {
+  std::vector<std::array<int, 2>> links;
+  std::unordered_set<uint64_t> is_link;
+  std::vector<std::vector<int>> linked;  // per seed, the seeds it has a link with
+
+  Chain(size_t num_seeds, std::vector<std::array<int, 2>> l) : links(std::move(l)), linked(num_seeds) {
+    for (const auto& [a, b] : links) {
+      is_link.insert(EdgeKey(MakeEdge(a, b)));
+      linked[static_cast<size_t>(a)].push_back(b);
+      linked[static_cast<size_t>(b)].push_back(a);
+    }
+  }
+  bool Linked(int a, int b) const { return is_link.count(EdgeKey(MakeEdge(a, b))) > 0; }
+};
+
+// A jump: two seeds x, y linked to one curve seed c on either side of it (more than 135 degrees apart at c)
+// and no link themselves. The triples on a jump, (x, y, z), are dropped together where each has its two
+// replacements (x, c, z) and (c, y, z) present (z = c: the sliver along the chain, replaced by nothing)
+// and no edge is left with one triple (KeepChainLinks). Returns the jumps taken.
+size_t DropChainJumps(const std::vector<Vec3>& seeds, const Chain& chain,
+                      const std::vector<std::vector<int>>& neighbours, LiveTriples& live) {
+  size_t jumps = 0;
+  std::vector<Tri> drop;
+  for (size_t ci = 0; ci < chain.linked.size(); ++ci) {
+    const auto& ends = chain.linked[ci];
+    const int c = static_cast<int>(ci);
+    for (size_t i = 0; i < ends.size(); ++i)
+      for (size_t j = i + 1; j < ends.size(); ++j) {
+        const int x = ends[i], y = ends[j];
+        if (chain.Linked(x, y) || live.OnEdge(x, y) == 0) continue;
+        const Vec3 cx = (seeds[static_cast<size_t>(x)] - seeds[ci]).normalized();
+        const Vec3 cy = (seeds[static_cast<size_t>(y)] - seeds[ci]).normalized();
+        if (!(cx.dot(cy) < kJumpMaxCos)) continue;  // a bend of the chain or two chains at a corner: no jump
+        drop.clear();
+        bool replaced = true;
+        for (int z : live.Thirds(x, y, neighbours)) {
+          replaced = replaced && (z == c || (live.Has(x, c, z) && live.Has(c, y, z)));
+          drop.push_back(SortedTri(x, y, z));
+        }
+        if (replaced && live.DropIfClosed(drop)) ++jumps;
+      }
+  }
+  return jumps;
+}
+
+// Where sheets cross at a gap of the chain: a closed tetrahedron (c, c', a, b) on a link cc', with a and b
+// sheet seeds on two sides of it and ab carrying 4+ triples, keeps its two triples on the link
+// (KeepChainLinks).
+void KeepLinksAcrossCrossings(const std::vector<Vec3>& seeds, const Chain& chain, const std::vector<uint8_t>& is_curve,
+                              const std::vector<std::vector<int>>& neighbours, LiveTriples& live) {
+  const double max_same_side_cos = std::cos(kLinkSideAngleDeg * M_PI / 180.0);
+  for (const auto& [c, d] : chain.links) {
+    const std::vector<int> third = live.Thirds(c, d, neighbours);
+    const Vec3 axis = (seeds[static_cast<size_t>(d)] - seeds[static_cast<size_t>(c)]).normalized();
+    auto across = [&](int x) {  // from the link towards x, across the link: unit
+      Vec3 v = seeds[static_cast<size_t>(x)] - seeds[static_cast<size_t>(c)];
+      v -= v.dot(axis) * axis;
+      return Vec3(v.normalized());
+    };
+    for (size_t i = 0; i < third.size(); ++i)
+      for (size_t j = i + 1; j < third.size(); ++j) {
+        const int a = third[i], b = third[j];
+        // A curve seed on the link's tetrahedron is the chain going on (a jump's business) or another chain.
+        if (is_curve[static_cast<size_t>(a)] || is_curve[static_cast<size_t>(b)]) continue;
+        if (!(across(a).dot(across(b)) < max_same_side_cos)) continue;  // one side of the link: a chart's business
+        // Only where ab is shared by 4+ triples: an edge of 2 (across a crease) thin-mesh's pair rule decides.
+        if (!live.Has(c, a, b) || !live.Has(d, a, b) || live.OnEdge(a, b) < 4) continue;
+        live.DropIfClosed({SortedTri(c, a, b), SortedTri(d, a, b)});
+      }
+  }
+}
+
+}  // namespace
+
+std::vector<Tri> KeepChainLinks(const std::vector<Vec3>& seeds, const std::vector<uint8_t>& is_curve,
+                                const std::vector<Tri>& triples, ChainLinkStats* stats_out) {
+  ChainLinkStats stats;
+  const std::vector<std::vector<int>> neighbours = GeodesicNeighbours(seeds.size(), triples);
+  const Chain chain(seeds.size(), ChainLinks(seeds, is_curve, neighbours));
+  stats.links = chain.links.size();
+  LiveTriples live(triples);
+  stats.jumps = DropChainJumps(seeds, chain, neighbours, live);
+  KeepLinksAcrossCrossings(seeds, chain, is_curve, neighbours, live);
+  std::vector<Tri> kept;
+  kept.reserve(triples.size());
+  for (const Tri& t : triples)
+    if (live.present.count(t)) kept.push_back(t);
+  stats.dropped = triples.size() - kept.size();
+  if (stats_out) *stats_out = stats;
+  return kept;
+}
+
+std::vector<Tri> LocallyDelaunayTriples(const std::vector<Vec3>& seeds, const std::vector<Vec3>& normals,
+                                        const std::vector<uint8_t>& on_sheet, const std::vector<Tri>& witnessed,
+                                        double chart_angle_deg, RestrictedDualStats* stats_out) {
+  RestrictedDualStats stats;
+  stats.witnessed = witnessed.size();
+  const std::vector<std::vector<int>> neighbours = GeodesicNeighbours(seeds.size(), witnessed);
   constexpr double kCocircular = 1e-9;
   constexpr double kMaxFlatness = 0.25;
   const double min_cos = std::cos(chart_angle_deg * M_PI / 180.0);

@@ -42,4 +42,38 @@ std::vector<Tri> LocallyDelaunayTriples(const std::vector<Vec3>& seeds, const st
                                         const std::vector<uint8_t>& on_sheet, const std::vector<Tri>& witnessed,
                                         double chart_angle_deg, RestrictedDualStats* stats);
 
+struct ChainLinkStats {
+  size_t links = 0;    ///< chain links found between curve seeds
+  size_t jumps = 0;    ///< jumps over a curve seed whose triples were dropped
+  size_t dropped = 0;  ///< triples dropped in all
+};
+
+/// The triples that follow the feature chains instead of jumping along or across them. A *chain link* is a
+/// pair of curve seeds (c, c') (rank 2 or 3: on a crease, a rim, a branching curve or a corner) that are
+/// geodesic neighbours (they share a triple) and consecutive: no third curve seed that is a geodesic
+/// neighbour of both lies strictly inside the sphere with diameter cc' (the Gabriel rule among the curve
+/// seeds; Gabriel & Sokal 1969). Two rules, in this order:
+///  - **jumps**: where x and y are both linked to a curve seed c, more than 135 degrees apart at c, and are no
+///    link themselves, the triples on xy jump c along the chain. They are dropped, all together, where each
+///    (x, y, z) has its replacements (x, c, z) and (c, y, z) present (z = c: the sliver along the chain).
+///  - **crossings**: where the four triples of a link cc' and two sheet seeds a, b are all present — a closed
+///    tetrahedron, two ways of spanning one junction — a and b lie on two sides of the link (their directions
+///    from it, across it, more than 60 degrees apart) and ab carries 4 or more triples, the two triples on
+///    ab, (c, a, b) and (c', a, b), are dropped and the two on the link stay. Where sheets cross at a gap of
+///    the chain, the triples on ab cut across the curve; no chart decides there (the four seeds span two
+///    planes), and thin-mesh's pair rule needs an edge of exactly two triples (an edge of two, across a
+///    crease, is left to it).
+///
+/// Invariant: a triple is dropped only where the triples that replace it are present, and a drop that would
+/// leave any edge with one triple where it had more is not made: no edge loses its last triple and no new
+/// boundary edge appears, so no hole opens. Jumps and links are taken in seed order on the live triples
+/// (deterministic).
+///
+/// \param seeds     seed positions
+/// \param is_curve  per seed, whether it lies on a feature curve or a corner (rank 2 or 3)
+/// \param triples   triples of seed indices, each vertex triple once, indices sorted
+/// \returns the kept triples in the order given
+std::vector<Tri> KeepChainLinks(const std::vector<Vec3>& seeds, const std::vector<uint8_t>& is_curve,
+                                const std::vector<Tri>& triples, ChainLinkStats* stats);
+
 }  // namespace voroudf

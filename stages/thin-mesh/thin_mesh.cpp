@@ -23,15 +23,6 @@ Tri Sorted(Tri t) {
   return t;
 }
 
-struct TriHash {
-  size_t operator()(const Tri& t) const {
-    uint64_t h = static_cast<uint32_t>(t[0]);
-    h = h * 0x9E3779B97F4A7C15ull ^ static_cast<uint32_t>(t[1]);
-    h = h * 0x9E3779B97F4A7C15ull ^ static_cast<uint32_t>(t[2]);
-    return static_cast<size_t>(h ^ (h >> 29));
-  }
-};
-
 /// The mutable state of the thinning: faces, which are still present, and the valence of every edge.
 class Thinner {
  public:
