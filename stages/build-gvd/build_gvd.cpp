@@ -564,8 +564,8 @@ GvdResult BuildGvd(const Udf& udf, const SeedCloud& seeds, const BuildGvdOptions
       for (size_t i = 0; i < num_seeds; ++i) is_curve[i] = IsCurveSeed(seeds, i);
       ChainLinkStats cl;
       faces = KeepChainLinks(seeds.position, is_curve, faces, &cl);
-      monitor.Info(Format("chain links: %zu between curve seeds; %zu jumps over a curve seed and the crossings dropped %zu triples",
-                          cl.links, cl.jumps, cl.dropped));
+      monitor.Info(Format("chain links: %zu between curve seeds; %zu triples dropped (%zu jumps over a curve seed, "
+                          "the rest across crossings)", cl.links, cl.dropped, cl.jumps));
     }
   }
   stats.triangles = faces.size();
