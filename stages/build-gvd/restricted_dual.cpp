@@ -126,7 +126,7 @@ struct LiveTriples {
     return third;
   }
   // Drops `drop` unless that leaves an edge with one triple that had more: no new boundary edge.
-  bool DropIfClosed(const std::vector<Tri>& drop) {
+  bool DropUnlessItOpens(const std::vector<Tri>& drop) {
     std::unordered_map<uint64_t, int> after;
     for (const Tri& t : drop)
       for (int k = 0; k < 3; ++k) {
@@ -186,7 +186,7 @@ size_t DropChainJumps(const std::vector<Vec3>& seeds, const Chain& chain,
           replaced = replaced && (z == c || (live.Has(x, c, z) && live.Has(c, y, z)));
           drop.push_back(SortedTri(x, y, z));
         }
-        if (replaced && live.DropIfClosed(drop)) ++jumps;
+        if (replaced && live.DropUnlessItOpens(drop)) ++jumps;
       }
   }
   return jumps;
@@ -214,7 +214,7 @@ void KeepLinksAcrossCrossings(const std::vector<Vec3>& seeds, const Chain& chain
         if (!(across(a).dot(across(b)) < max_same_side_cos)) continue;  // one side of the link: a chart's business
         // Only where ab is shared by 4+ triples: an edge of 2 (across a crease) thin-mesh's pair rule decides.
         if (!live.Has(c, a, b) || !live.Has(d, a, b) || live.OnEdge(a, b) < 4) continue;
-        live.DropIfClosed({SortedTri(c, a, b), SortedTri(d, a, b)});
+        live.DropUnlessItOpens({SortedTri(c, a, b), SortedTri(d, a, b)});
       }
   }
 }
