@@ -28,6 +28,14 @@ std::set<Tri> SortedFaces(const TriangleMesh& mesh) {
   return out;
 }
 
+// The fins some tests stand on the disc are not in its field: step 6 would take their end faces for faces
+// off the surface at a rim.
+ThinMeshOptions FinNotInField() {
+  ThinMeshOptions o;
+  o.rim_flaps = false;
+  return o;
+}
+
 ThinMeshOptions MinFaces(size_t n) {
   ThinMeshOptions o;
   o.min_component_faces = n;
@@ -279,7 +287,7 @@ TEST(ThinMesh, ANotchAtABranchingLineIsClosed) {
   const int v22 = 16, v33 = 24, v23 = 23;
   m.faces.erase(std::find(m.faces.begin(), m.faces.end(), Tri{v22, v33, v23}));
   ThinMeshStats stats;
-  const TriangleMesh out = ThinMesh(*udf, m, ThinMeshOptions{}, Monitor::Null(), &stats);
+  const TriangleMesh out = ThinMesh(*udf, m, FinNotInField(), Monitor::Null(), &stats);
   EXPECT_EQ(stats.holes_closed, 1u);
   EXPECT_TRUE(SortedFaces(out).count({v22, v23, v33}));
   ExpectGridWithWholeFin(out);
@@ -297,7 +305,7 @@ TEST(ThinMesh, AFaceOverACrackAtABranchingLineIsSplit) {
   for (const Tri& t : std::vector<Tri>{{v13, base + 2, base + 1}, {v13, v33, base + 2}, {v33, base + 3, base + 2}})
     m.faces.push_back(t);
   ThinMeshStats stats;
-  const TriangleMesh out = ThinMesh(*udf, m, ThinMeshOptions{}, Monitor::Null(), &stats);
+  const TriangleMesh out = ThinMesh(*udf, m, FinNotInField(), Monitor::Null(), &stats);
   EXPECT_EQ(stats.cracks_split, 1u);
   EXPECT_TRUE(SortedFaces(out).count({v13, v23, base + 2}));
   EXPECT_TRUE(SortedFaces(out).count({v23, v33, base + 2}));
@@ -323,7 +331,7 @@ TEST(ThinMesh, AFlapLeftDanglingByANotchIsCollapsedKeepingChi) {
   m.faces.erase(std::find(m.faces.begin(), m.faces.end(), Tri{v25, v36, v26}));
   m.faces.push_back({v25, v36, top[6]});
   ThinMeshStats stats;
-  const TriangleMesh out = ThinMesh(*udf, m, ThinMeshOptions{}, Monitor::Null(), &stats);
+  const TriangleMesh out = ThinMesh(*udf, m, FinNotInField(), Monitor::Null(), &stats);
   EXPECT_EQ(stats.holes_closed, 1u);
   EXPECT_EQ(stats.flap_faces_removed, 1u);
   EXPECT_TRUE(SortedFaces(out).count({v25, v26, v36}));
@@ -340,6 +348,37 @@ TEST(ThinMesh, AFlapLeftDanglingByANotchIsCollapsedKeepingChi) {
   const TopologyStats p = ComputeTopology(ThinMesh(*udf, m, paper, Monitor::Null()));
   EXPECT_EQ(p.nonmanifold_edges, 13u);
   EXPECT_EQ(p.boundary_edges, 36u + 14u + 3u);
+}
+
+// The end of crossing-planes' branching line (the y axis, from y = -0.5) at `y0`: a seed on the line there and
+// one further in, a seed of each of the four half-planes beside them, a rim seed of the +x and of the -z
+// half-planes at y0, and a flap the dual put across the line: from the +x rim seed to the -z seed, through
+// the line's end (the last face).
+TriangleMesh LineEndWithAFlap(double y0) {
+  TriangleMesh m;
+  m.vertices = {{0, y0, 0},           {0, y0 + 0.1, 0}, {0.1, y0 + 0.05, 0},  {0.1, y0, 0},         // end, line, +x, +x rim
+                {0, y0 + 0.05, -0.1}, {0, y0, -0.12},   {-0.1, y0 + 0.05, 0}, {0, y0 + 0.05, 0.1}};  // -z, -z rim, -x, +z
+  m.faces = {{0, 1, 2}, {0, 2, 3}, {0, 1, 4}, {0, 4, 5}, {0, 1, 6}, {0, 1, 7}, {0, 3, 4}};
+  return m;
+}
+
+TEST(ThinMesh, AFlapAcrossTheEndOfABranchingLineAtTheRimsIsRemoved) {
+  const auto udf = MakeShape("crossing-planes");
+  ThinMeshOptions options = MinFaces(1);
+  ThinMeshStats stats;
+  const TriangleMesh out = ThinMesh(*udf, LineEndWithAFlap(-0.5), options, Monitor::Null(), &stats);
+  EXPECT_EQ(stats.rim_flaps_removed, 1u);
+  EXPECT_FALSE(SortedFaces(out).count({0, 3, 4}));
+  const TopologyStats topo = ComputeTopology(out);
+  EXPECT_EQ(topo.nonmanifold_edges, 1u) << "only the line's own edge, with its four sheets";
+  // In the middle of the squares the same flap leaves the edge (end, +x rim) with one face where the +x
+  // sheet goes on beyond it: no rim, the flap stays.
+  const TriangleMesh mid = ThinMesh(*udf, LineEndWithAFlap(-0.1), options, Monitor::Null(), &stats);
+  EXPECT_EQ(stats.rim_flaps_removed, 0u);
+  EXPECT_TRUE(SortedFaces(mid).count({0, 3, 4}));
+  // Off (or with --thinning paper), step 6 does not run.
+  options.rim_flaps = false;
+  EXPECT_TRUE(SortedFaces(ThinMesh(*udf, LineEndWithAFlap(-0.5), options, Monitor::Null())).count({0, 3, 4}));
 }
 
 TEST(ThinMesh, ManifoldComponentsAreOrientedConsistently) {
@@ -395,7 +434,8 @@ TEST_F(ThinMeshExe, WritesMeshAndNonManifoldEdges) {
   m.faces.push_back({16, 24, AddVertex(m, {-0.05, -0.05, 0.05})});  // a fin, kept with --min-component-faces 1
   WriteMeshPly(dir_ / "thick.ply", m, Provenance{"test", "", ""});
   const auto r = RunProgram("thin-mesh", {"--udf", "shape:disc", "-i", dir_ / "thick.ply", "-o", dir_ / "mesh.ply",
-                                          "--nm-edges", dir_ / "nm.ply", "--min-component-faces", "1"});
+                                          "--nm-edges", dir_ / "nm.ply", "--min-component-faces", "1",
+                                          "--rim-flaps", "false"});  // the fin is not in the field
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_TRUE(r.out.empty());
   const TriangleMesh out = ReadMeshPly(dir_ / "mesh.ply");

@@ -31,6 +31,9 @@ int main(int argc, char** argv) {
                  "faces that stay (a second layer); 180: always, as the paper");
   app.add_option("--overlap-angle", options.overlap_angle_deg,
                  "a face added to close a gap must not lie within this angle (deg) of a face on its edges");
+  app.add_option("--rim-flaps", options.rim_flaps,
+                 "remove the faces hanging from a free edge across a non-manifold edge where the edges they leave "
+                 "open lie on a rim (true/false; not with --thinning paper)");
 
   return cli.Run(argc, argv, [&] { options.Check(); }, [&](voroudf::Monitor& monitor) {
     const auto udf = cli.OpenUdf(monitor);

@@ -29,6 +29,9 @@ struct ThinMeshOptions {
   /// edge only if each of its faces on a border edge lies within this angle of a face that stays on that
   /// edge (a second layer: a bubble's cap, a fold); 180 removes every small component, as the paper does.
   double layer_angle_deg = 60.0;
+  /// --rim-flaps (not with --thinning paper): step 6 removes the faces that hang from a free edge across a
+  /// non-manifold edge where every edge they leave with one face lies on a rim (no surface beyond it).
+  bool rim_flaps = true;
 
   /// Throws UsageError for values that cannot work.
   void Check() const;
@@ -48,6 +51,7 @@ struct ThinMeshStats {
   size_t holes_closed = 0;          ///< step 4: triangular holes and notches given their face
   size_t tetrahedra_closed_thinned = 0;  ///< step 5: tetrahedra that step 4's faces closed, thinned
   size_t flap_faces_removed = 0;    ///< step 5: faces of dangling flaps removed
+  size_t rim_flaps_removed = 0;     ///< step 6: flaps at a rim removed
   int rounds = 0;                   ///< rounds of (tetrahedra, components) until nothing changed
 };
 
@@ -70,6 +74,10 @@ struct ThinMeshStats {
 ///  5. Then, if step 4 changed anything: the closed tetrahedra (step 1's rule), and a small component (as in
 ///     step 2) that has a free edge is removed when that leaves no border edge with a single face and keeps
 ///     the Euler characteristic (a dangling flap, collapsed from its free edge).
+///  6. Unless thinning is "paper" or rim_flaps is off: a face with a free edge and a non-manifold edge is
+///     removed when every edge it leaves with one face lies on a rim: the UDF shows no surface beyond that
+///     edge. Where a branching curve ends at the rims of its sheets, the regions of a rim seed of one sheet
+///     and a seed of another meet at the curve's end, and the dual joins them by a face across the curve.
 ///  Manifold components are then oriented consistently, unreferenced vertices dropped (order kept).
 ///
 /// \param udf    the field, for the centroid values
