@@ -6,6 +6,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <unordered_map>
+#include <utility>
 #include <vector>
 
 #include "common/types.h"
@@ -17,6 +18,14 @@ using Edge = std::array<int, 2>;  ///< vertex indices, smaller first
 inline Edge MakeEdge(int a, int b) { return a < b ? Edge{a, b} : Edge{b, a}; }
 inline uint64_t EdgeKey(const Edge& e) {
   return (static_cast<uint64_t>(static_cast<uint32_t>(e[0])) << 32) | static_cast<uint32_t>(e[1]);
+}
+
+/// The vertex triple in increasing order: the key of "the same three vertices" in any orientation.
+inline Tri SortedTri(Tri t) {
+  if (t[0] > t[1]) std::swap(t[0], t[1]);
+  if (t[1] > t[2]) std::swap(t[1], t[2]);
+  if (t[0] > t[1]) std::swap(t[0], t[1]);
+  return t;
 }
 
 /// A hash of a vertex triple (as stored: callers that mean "the same three vertices" sort them first).

@@ -66,12 +66,6 @@ std::vector<std::vector<int>> GeodesicNeighbours(size_t num_seeds, const std::ve
   return neighbours;
 }
 
-Tri SortedTri(int a, int b, int c) {
-  Tri t{a, b, c};
-  std::sort(t.begin(), t.end());
-  return t;
-}
-
 // Seeds a and b lie on two sides of a link (two faces of a crease, two sheets where sheets cross, or the
 // two sides of a sheet's curve) when the directions from the link to them, across it, differ by more than
 // this: on one side of it (one face, a curved one included) they lie within a few tens of degrees.
@@ -112,7 +106,7 @@ struct LiveTriples {
     for (const Tri& t : triples)
       for (int k = 0; k < 3; ++k) ++per_edge[EdgeKey(MakeEdge(t[k], t[(k + 1) % 3]))];
   }
-  bool Has(int a, int b, int c) const { return present.count(SortedTri(a, b, c)) > 0; }
+  bool Has(int a, int b, int c) const { return present.count(SortedTri({a, b, c})) > 0; }
   int OnEdge(int a, int b) const {
     const auto it = per_edge.find(EdgeKey(MakeEdge(a, b)));
     return it == per_edge.end() ? 0 : it->second;
@@ -184,7 +178,7 @@ size_t DropChainJumps(const std::vector<Vec3>& seeds, const Chain& chain,
         bool replaced = true;
         for (int z : live.Thirds(x, y, neighbours)) {
           replaced = replaced && (z == c || (live.Has(x, c, z) && live.Has(c, y, z)));
-          drop.push_back(SortedTri(x, y, z));
+          drop.push_back(SortedTri({x, y, z}));
         }
         if (replaced && live.DropUnlessItOpens(drop)) ++jumps;
       }
@@ -214,7 +208,7 @@ void KeepLinksAcrossCrossings(const std::vector<Vec3>& seeds, const Chain& chain
         if (!(across(a).dot(across(b)) < max_same_side_cos)) continue;  // one side of the link: a chart's business
         // Only where ab is shared by 4+ triples: an edge of 2 (across a crease) thin-mesh's pair rule decides.
         if (!live.Has(c, a, b) || !live.Has(d, a, b) || live.OnEdge(a, b) < 4) continue;
-        live.DropUnlessItOpens({SortedTri(c, a, b), SortedTri(d, a, b)});
+        live.DropUnlessItOpens({SortedTri({c, a, b}), SortedTri({d, a, b})});
       }
   }
 }

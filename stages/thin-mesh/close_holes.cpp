@@ -12,11 +12,6 @@ namespace {
 using EdgePair = std::pair<int, int>;
 EdgePair KeyOf(int u, int v) { return {std::min(u, v), std::max(u, v)}; }
 
-Tri Sorted(Tri t) {
-  std::sort(t.begin(), t.end());
-  return t;
-}
-
 /// Whether a face of triangle quality `quality` counts as degenerate (below `min_quality`, or of zero area).
 bool IsDegenerate(double quality, double min_quality) { return !(quality >= min_quality) || quality == 0.0; }
 
@@ -101,7 +96,7 @@ size_t CloseTriangularHoles(const std::vector<Vec3>& vertices, std::vector<Tri>&
       for (size_t j = i + 1; j < nb.size(); ++j) {
         const int a = nb[i], c = nb[j];
         if (!fans.HasEdge(a, c)) continue;
-        const Tri t = Sorted({a, b, c});
+        const Tri t = SortedTri({a, b, c});
         if (!done.insert(t).second || !fans.Fits(vertices, a, b, c, min_quality, min_cos)) continue;
         faces.push_back(t);
         ++added;
@@ -133,7 +128,7 @@ size_t SplitFacesOverCracks(const std::vector<Vec3>& vertices, std::vector<Tri>&
       }
     }
     std::set<Tri> existing;
-    for (const Tri& t : faces) existing.insert(Sorted(t));
+    for (const Tri& t : faces) existing.insert(SortedTri(t));
     std::vector<char> used(faces.size(), 0);
     std::vector<Tri> added;
     for (const auto& [e, w] : fans.third) {
@@ -151,7 +146,7 @@ size_t SplitFacesOverCracks(const std::vector<Vec3>& vertices, std::vector<Tri>&
         if (t > 0.0 && t < 1.0 && q < best_quality) best = m, best_quality = q;
       }
       if (best < 0) continue;
-      const Tri h1 = Sorted({a, best, s}), h2 = Sorted({best, b, s});
+      const Tri h1 = SortedTri({a, best, s}), h2 = SortedTri({best, b, s});
       if (IsDegenerate(TriangleQuality(at(a), at(best), at(s)), min_quality) ||
           IsDegenerate(TriangleQuality(at(best), at(b), at(s)), min_quality) || existing.count(h1) || existing.count(h2) ||
           fans.Over(vertices, a, best, s, min_cos) || fans.Over(vertices, best, b, s, min_cos))

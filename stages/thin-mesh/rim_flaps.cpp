@@ -43,15 +43,26 @@ constexpr double kOffSurface = 0.1;
 }  // namespace
 
 size_t RemoveRimFlaps(const Udf& udf, const std::vector<Vec3>& v, std::vector<Tri>& faces) {
-  std::vector<Vec3> centroid(faces.size());
-  for (size_t f = 0; f < faces.size(); ++f)
-    centroid[f] = (v[static_cast<size_t>(faces[f][0])] + v[static_cast<size_t>(faces[f][1])] + v[static_cast<size_t>(faces[f][2])]) / 3.0;
-  std::vector<double> centroid_udf;
-  std::vector<Vec3> centroid_grad;
-  udf.Evaluate(centroid, centroid_udf, centroid_grad);
   const EdgeFaces inc = BuildEdgeFaces(faces);
   std::vector<int> count(inc.edges.size());
   for (size_t e = 0; e < count.size(); ++e) count[e] = static_cast<int>(inc.faces[e].size());
+  // Centroid UDFs, in one batch, of the faces that can be flaps: counts only fall, so a face on no branching
+  // edge now never stands on one.
+  std::vector<double> centroid_udf(faces.size(), 0.0);
+  std::vector<size_t> asked;
+  std::vector<Vec3> centroid;
+  for (size_t e = 0; e < count.size(); ++e)
+    if (count[e] >= 3)
+      for (int f : inc.faces[e]) asked.push_back(static_cast<size_t>(f));
+  std::sort(asked.begin(), asked.end());
+  asked.erase(std::unique(asked.begin(), asked.end()), asked.end());
+  for (size_t f : asked)
+    centroid.push_back((v[static_cast<size_t>(faces[f][0])] + v[static_cast<size_t>(faces[f][1])] +
+                        v[static_cast<size_t>(faces[f][2])]) / 3.0);
+  std::vector<double> asked_udf;
+  std::vector<Vec3> asked_grad;
+  if (!centroid.empty()) udf.Evaluate(centroid, asked_udf, asked_grad);
+  for (size_t k = 0; k < asked.size(); ++k) centroid_udf[asked[k]] = asked_udf[k];
   std::vector<char> alive(faces.size(), 1);
   size_t removed = 0;
   for (size_t f = 0; f < faces.size(); ++f) {

@@ -19,11 +19,6 @@
 namespace voroudf {
 namespace {
 
-Tri Sorted(Tri t) {
-  std::sort(t.begin(), t.end());
-  return t;
-}
-
 /// The mutable state of the thinning: faces, which are still present, and the valence of every edge.
 class Thinner {
  public:
@@ -43,14 +38,14 @@ class Thinner {
         ++vertex_faces_[static_cast<size_t>(v)];
       }
       face_edges_[f] = {incidence_.Find(t[0], t[1]), incidence_.Find(t[1], t[2]), incidence_.Find(t[2], t[0])};
-      by_vertices_.emplace(Sorted(t), static_cast<int>(f));
+      by_vertices_.emplace(SortedTri(t), static_cast<int>(f));
     }
   }
 
   const std::vector<Tri>& faces() const { return faces_; }
   /// The centroid UDF of the present face over the vertices of `t` (any order), if there is one.
   bool CentroidUdf(const Tri& t, double* udf) const {
-    const int f = Present(Sorted(t));
+    const int f = Present(SortedTri(t));
     if (f >= 0) *udf = udf_[static_cast<size_t>(f)];
     return f >= 0;
   }
@@ -62,7 +57,7 @@ class Thinner {
     std::vector<std::pair<std::array<int, 4>, std::array<int, 4>>> found;
     for (size_t f = 0; f < faces_.size(); ++f) {
       if (!alive_[f]) continue;
-      const Tri t = Sorted(faces_[f]);
+      const Tri t = SortedTri(faces_[f]);
       const int a = t[0], b = t[1], c = t[2];
       const int eab = incidence_.Find(a, b);
       for (int g : incidence_.faces[static_cast<size_t>(eab)]) {
@@ -340,7 +335,7 @@ std::vector<Tri> CleanFaces(const TriangleMesh& thick, double min_quality, ThinM
                                          min_quality);
     if (degenerate) {
       ++st.degenerate_faces;
-    } else if (!seen.insert(Sorted(t)).second) {
+    } else if (!seen.insert(SortedTri(t)).second) {
       ++st.duplicate_faces;
     } else {
       faces.push_back(t);
