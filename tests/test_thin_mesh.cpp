@@ -6,6 +6,7 @@
 #include <set>
 
 #include "common/errors.h"
+#include "common/mesh_udf.h"
 #include "common/mesh_topology.h"
 #include "common/shapes.h"
 #include "formats/mesh_io.h"
@@ -379,6 +380,104 @@ TEST(ThinMesh, AFlapAcrossTheEndOfABranchingLineAtTheRimsIsRemoved) {
   // Off (or with --thinning paper), step 6 does not run.
   options.rim_flaps = false;
   EXPECT_TRUE(SortedFaces(ThinMesh(*udf, LineEndWithAFlap(-0.5), options, Monitor::Null())).count({0, 3, 4}));
+}
+
+/// A fin (one face to a new vertex out in the disc's plane) on every edge of `m`'s faces: every edge of the
+/// shell then carries a third face, so no face pair of a tetrahedron shares a manifold edge (step 1 is stuck,
+/// as on a branching curve) and every face is a component of its own.
+TriangleMesh WithFins(TriangleMesh m) {
+  std::set<std::pair<int, int>> edges;
+  for (const Tri& t : m.faces)
+    for (int k = 0; k < 3; ++k) edges.insert(std::minmax(t[k], t[(k + 1) % 3]));
+  int n = 0;
+  for (const auto& [a, b] : edges) {
+    const Vec3 mid = 0.5 * (m.vertices[a] + m.vertices[b]);
+    const int w = AddVertex(m, {mid.x() + 0.05 * ++n, mid.y() + 0.6, 0.0});
+    m.faces.push_back({a, b, w});
+  }
+  return m;
+}
+
+/// A triangular bipyramid: the triangle a, b, c on the disc and apexes above and below its centre at
+/// heights z_up and -z_down; six faces, no tetrahedron.
+TriangleMesh Bipyramid(double z_up, double z_down) {
+  TriangleMesh m;
+  m.vertices = {{-0.2, -0.1, 0.0}, {0.2, -0.1, 0.0}, {0.0, 0.2, 0.0}, {0.0, 0.0, z_up}, {0.0, 0.0, -z_down}};
+  m.faces = {{0, 1, 3}, {1, 2, 3}, {2, 0, 3}, {0, 1, 4}, {1, 2, 4}, {2, 0, 4}};
+  return m;
+}
+
+// MinFaces(1) without step 6: the fins of WithFins reach beyond the disc's field, off the surface at a rim.
+ThinMeshOptions ShellsOnly() {
+  ThinMeshOptions o = MinFaces(1);
+  o.rim_flaps = false;
+  return o;
+}
+
+TEST(ThinMesh, AStuckShellIsOpenedAtOneFaceOffTheSurfaceAndChiFallsByOne) {
+  const auto udf = MakeShape("disc");
+  // c and d lifted: acd and bcd have the highest centroids (0.1, above 0.1 x their longest edge 0.4);
+  // acd comes first in face order. Removing it opens the shell, so bcd stays.
+  for (const TriangleMesh& shell : {Tetrahedron(0.0, 0.0, 0.15, 0.15), Bipyramid(0.15, 0.05)}) {
+    const TriangleMesh thick = WithFins(shell);
+    const long long chi_before = ComputeTopology(thick).euler;
+    ThinMeshStats stats;
+    const TriangleMesh out = ThinMesh(*udf, thick, ShellsOnly(), Monitor::Null(), &stats);
+    EXPECT_EQ(stats.tetrahedra_thinned, 0u) << "no pair shares a manifold edge";
+    EXPECT_EQ(stats.shells_opened, 1u);
+    EXPECT_EQ(stats.tetrahedra_left, 0u);
+    ASSERT_EQ(out.faces.size(), thick.faces.size() - 1);
+    const std::set<Tri> faces = SortedFaces(out);
+    EXPECT_FALSE(faces.count(SortedTri(shell.faces[shell.faces.size() == 4 ? 2 : 0]))) << "the highest face goes";
+    const TopologyStats topo = ComputeTopology(out);
+    EXPECT_EQ(topo.euler, chi_before - 1) << "b2 falls by one, b1 stays";
+    EXPECT_EQ(topo.boundary_edges, ComputeTopology(thick).boundary_edges) << "no edge left with one face";
+  }
+  // Off, or with --thinning paper, the shell stays closed.
+  ThinMeshOptions off = ShellsOnly();
+  off.shell_rings = 0;
+  EXPECT_EQ(ThinMesh(*udf, WithFins(Tetrahedron(0.0, 0.0, 0.15, 0.15)), off, Monitor::Null()).faces.size(), 10u);
+  off = ShellsOnly();
+  off.thinning = "paper";
+  EXPECT_EQ(ThinMesh(*udf, WithFins(Bipyramid(0.15, 0.05)), off, Monitor::Null()).faces.size(), 15u);
+}
+
+TEST(ThinMesh, AShellWhoseFacesAllLieOnTheSurfaceIsACavityAndStays) {
+  // The same stuck tetrahedron, in the field of itself: every face on the zero set, so none is off it.
+  const TriangleMesh thick = WithFins(Tetrahedron(0.0, 0.0, 0.15, 0.15));
+  const MeshUdf udf(thick, "tetrahedron with fins");
+  ThinMeshStats stats;
+  const TriangleMesh out = ThinMesh(udf, thick, ShellsOnly(), Monitor::Null(), &stats);
+  EXPECT_EQ(stats.shells_opened, 0u);
+  EXPECT_EQ(stats.tetrahedra_left, 1u);
+  EXPECT_EQ(SortedFaces(out), SortedFaces(thick));
+}
+
+TEST(ThinMesh, OpeningShellsNeverOpensAHoleInAClosedSurface) {
+  // A closed surface (the octahedron's 8 faces on the disc's field, its equator on the disc) with a bubble
+  // glued into it: a tetrahedron on one of its faces, lifted off the field. The surface's own shell is
+  // within one ring of every face too, but its faces off the surface are opened only while a bubble closes
+  // them: the result keeps the octahedron closed and opens only the bubble.
+  TriangleMesh m;
+  m.vertices = {{0.2, 0, 0}, {0, 0.2, 0}, {-0.2, 0, 0}, {0, -0.2, 0}, {0, 0, 0.02}, {0, 0, -0.02}};
+  for (int k = 0; k < 4; ++k) {
+    m.faces.push_back({k, (k + 1) % 4, 4});
+    m.faces.push_back({(k + 1) % 4, k, 5});
+  }
+  const int apex = AddVertex(m, {0.05, 0.05, 0.3});
+  m.faces.insert(m.faces.end(), {{0, 1, apex}, {1, 4, apex}, {4, 0, apex}});  // a tetrahedron on face (0, 1, 4)
+  for (int v : {0, 1, 4}) m.faces.push_back({v, apex, AddVertex(m, m.vertices[v] + Vec3(0.0, 0.0, 0.3))});  // fins
+  const auto udf = MakeShape("disc");
+  ThinMeshStats stats;
+  const TriangleMesh out = ThinMesh(*udf, m, ShellsOnly(), Monitor::Null(), &stats);
+  EXPECT_EQ(stats.tetrahedra_thinned, 0u);
+  EXPECT_EQ(stats.shells_opened, 1u);
+  const TopologyStats topo = ComputeTopology(out);
+  EXPECT_EQ(topo.boundary_edges, ComputeTopology(m).boundary_edges) << "no hole opened";
+  EXPECT_EQ(topo.euler, ComputeTopology(m).euler - 1) << "one closed surface left of the two shells";
+  // The octahedron's 8 faces all stay.
+  const std::set<Tri> kept = SortedFaces(out);
+  for (size_t f = 0; f < 8; ++f) EXPECT_TRUE(kept.count(SortedTri(m.faces[f])));
 }
 
 TEST(ThinMesh, ManifoldComponentsAreOrientedConsistently) {

@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "common/mesh_topology.h"
+#include "stages/thin-mesh/off_surface.h"
 
 namespace voroudf {
 namespace {
@@ -35,10 +36,6 @@ bool OnRim(const Udf& udf, const std::vector<Vec3>& p, int a, int b, int inner) 
   return *std::min_element(d.begin(), d.end()) > 0.3 * radius;
 }
 
-// A face is off the surface when its centroid's UDF is above this x its longest edge (a face of a
-// sheet, even a curved one at the seed spacing, has a few hundredths at most; a face across a branching
-// line, from one sheet to another, about a third).
-constexpr double kOffSurface = 0.1;
 
 }  // namespace
 
@@ -75,10 +72,9 @@ size_t RemoveRimFlaps(const Udf& udf, const std::vector<Vec3>& v, std::vector<Tr
       branching = branching || count[static_cast<size_t>(x)] >= 3;
     }
     if (!free_edge || !branching) continue;
-    double longest = 0.0;
-    for (int k = 0; k < 3; ++k)
-      longest = std::max(longest, (v[static_cast<size_t>(t[static_cast<size_t>(k)])] - v[static_cast<size_t>(t[static_cast<size_t>((k + 1) % 3)])]).norm());
-    if (!(centroid_udf[f] > kOffSurface * longest)) continue;
+    if (!OffSurface(centroid_udf[f], v[static_cast<size_t>(t[0])], v[static_cast<size_t>(t[1])],
+                    v[static_cast<size_t>(t[2])]))
+      continue;
     bool opens = false;
     for (int k = 0; k < 3 && !opens; ++k) {
       const size_t x = static_cast<size_t>(e[static_cast<size_t>(k)]);

@@ -1,7 +1,9 @@
 #include "stages/thin-mesh/thin_mesh.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <functional>
 #include <map>
@@ -14,10 +16,51 @@
 #include "common/mesh_topology.h"
 #include "common/union_find.h"
 #include "stages/thin-mesh/close_holes.h"
+#include "stages/thin-mesh/off_surface.h"
 #include "stages/thin-mesh/rim_flaps.h"
 
 namespace voroudf {
 namespace {
+
+/// Whether the edge set `target` (a face's three edges) is, over GF(2), a sum of the edge sets `rows`:
+/// Gaussian elimination on bitsets over the edges that occur, each row reduced against an echelon basis
+/// keyed by its leading bit. Written by hand: the sets are tens of faces, and Eigen has no GF(2) solver.
+bool InGf2Span(const std::array<int, 3>& target, const std::vector<std::array<int, 3>>& rows) {
+  std::unordered_map<int, int> column;
+  for (int e : target) column.emplace(e, static_cast<int>(column.size()));
+  for (const auto& r : rows)
+    for (int e : r) column.emplace(e, static_cast<int>(column.size()));
+  const size_t words = (column.size() + 63) / 64;
+  auto bits = [&](const std::array<int, 3>& edges) {
+    std::vector<uint64_t> row(words, 0);
+    for (int e : edges) {
+      const int c = column.at(e);
+      row[static_cast<size_t>(c / 64)] ^= uint64_t{1} << (c % 64);
+    }
+    return row;
+  };
+  auto lead = [&](const std::vector<uint64_t>& row) {
+    for (size_t w = words; w-- > 0;)
+      if (row[w]) return static_cast<int>(w * 64 + 63) - __builtin_clzll(row[w]);
+    return -1;
+  };
+  std::unordered_map<int, std::vector<uint64_t>> basis;
+  auto reduce = [&](std::vector<uint64_t>& row) {  // to zero (returns -1) or to a new leading bit
+    for (int l = lead(row); l >= 0; l = lead(row)) {
+      const auto it = basis.find(l);
+      if (it == basis.end()) return l;
+      for (size_t w = 0; w < words; ++w) row[w] ^= it->second[w];
+    }
+    return -1;
+  };
+  for (const auto& r : rows) {
+    std::vector<uint64_t> row = bits(r);
+    const int l = reduce(row);
+    if (l >= 0) basis.emplace(l, std::move(row));
+  }
+  std::vector<uint64_t> t = bits(target);
+  return reduce(t) < 0;
+}
 
 /// The mutable state of the thinning: faces, which are still present, and the valence of every edge.
 class Thinner {
@@ -128,6 +171,38 @@ class Thinner {
       ++thinned;
     }
     return thinned;
+  }
+
+  /// Step 3b: opens every closed shell of present faces that lies within `rings` edges of one of its faces
+  /// and has a face off the surface (OffSurface), at the first such face in decreasing centroid UDF. Each
+  /// face in that order is removed when it is off the surface and its boundary is, over GF(2), the sum of the
+  /// boundaries of the other present faces near it (OnLocalShell). Removing a face of a 2-cycle lowers b2 by
+  /// one and changes neither b0 nor b1, so no hole opens; removing faces only breaks cycles, so one pass
+  /// finds them all. A shell whose faces all lie on the surface is a cavity of the surface and stays.
+  /// Returns the faces removed.
+  size_t OpenLocalShells(int rings) {
+    if (!vertices_) return 0;
+    std::vector<std::vector<int>> vertex_faces(vertex_faces_.size());
+    for (size_t g = 0; g < faces_.size(); ++g)
+      if (alive_[g])
+        for (int v : faces_[g]) vertex_faces[static_cast<size_t>(v)].push_back(static_cast<int>(g));
+    std::vector<int> order;
+    for (size_t g = 0; g < faces_.size(); ++g)
+      if (alive_[g]) order.push_back(static_cast<int>(g));
+    std::stable_sort(order.begin(), order.end(),
+                     [&](int x, int y) { return udf_[static_cast<size_t>(x)] > udf_[static_cast<size_t>(y)]; });
+    size_t opened = 0;
+    for (int g : order) {
+      const Tri& t = faces_[static_cast<size_t>(g)];
+      const std::vector<Vec3>& p = *vertices_;
+      if (!OffSurface(udf_[static_cast<size_t>(g)], p[static_cast<size_t>(t[0])], p[static_cast<size_t>(t[1])],
+                      p[static_cast<size_t>(t[2])]) ||
+          !OnLocalShell(g, rings, vertex_faces))
+        continue;
+      Remove(g);
+      ++opened;
+    }
+    return opened;
   }
 
   /// Components connected across manifold edges, as face lists (each in increasing face order): first those
@@ -275,6 +350,37 @@ class Thinner {
   }
 
  private:
+  /// Whether face `f` lies on a 2-cycle of present faces whose vertices are all within `rings` edges of f's:
+  /// whether f's boundary is in the GF(2) span of the boundaries of those other faces.
+  bool OnLocalShell(int f, int rings, const std::vector<std::vector<int>>& vertex_faces) const {
+    for (int e : face_edges_[static_cast<size_t>(f)])
+      if (valence_[static_cast<size_t>(e)] < 2) return false;  // a free edge is on no 2-cycle
+    const Tri& tf = faces_[static_cast<size_t>(f)];
+    std::unordered_set<int> near(tf.begin(), tf.end());
+    std::vector<int> frontier(tf.begin(), tf.end());
+    for (int r = 0; r < rings; ++r) {
+      std::vector<int> next;
+      for (int v : frontier)
+        for (int g : vertex_faces[static_cast<size_t>(v)])
+          if (alive_[static_cast<size_t>(g)])
+            for (int w : faces_[static_cast<size_t>(g)])
+              if (near.insert(w).second) next.push_back(w);
+      frontier.swap(next);
+    }
+    std::vector<int> local;  // present faces other than f with every vertex near f
+    for (int v : near)
+      for (int g : vertex_faces[static_cast<size_t>(v)]) {
+        const Tri& t = faces_[static_cast<size_t>(g)];
+        if (g != f && alive_[static_cast<size_t>(g)] && near.count(t[0]) && near.count(t[1]) && near.count(t[2]))
+          local.push_back(g);
+      }
+    std::sort(local.begin(), local.end());
+    local.erase(std::unique(local.begin(), local.end()), local.end());
+    std::vector<std::array<int, 3>> rows;
+    for (int g : local) rows.push_back(face_edges_[static_cast<size_t>(g)]);
+    return InGf2Span(face_edges_[static_cast<size_t>(f)], rows);
+  }
+
   int Present(const Tri& sorted) const {
     const auto it = by_vertices_.find(sorted);
     return it != by_vertices_.end() && alive_[static_cast<size_t>(it->second)] ? it->second : -1;
@@ -315,6 +421,7 @@ void ThinMeshOptions::Check() const {
   if (!(overlap_angle_deg >= 0.0 && overlap_angle_deg < 90.0)) throw UsageError("--overlap-angle must be in [0, 90)");
   if (thinning != "paper" && thinning != "close-holes") throw UsageError("--thinning must be paper or close-holes");
   if (!(layer_angle_deg > 0.0 && layer_angle_deg <= 180.0)) throw UsageError("--layer-angle must be in (0, 180]");
+  if (shell_rings < 0 || shell_rings > 4) throw UsageError("--shell-rings must be in [0, 4]");
   if (!(degenerate_quality >= 0.0 && degenerate_quality < 0.5))
     throw UsageError("--degenerate-quality must be in [0, 0.5)");
 }
@@ -397,11 +504,6 @@ void PaperThinning(Thinner& thinner, const ThinMeshOptions& options, ThinMeshSta
     if (RemoveSmallComponents(thinner, options.min_component_faces, false, round, st, monitor) > 0) changed = true;
     if (!changed) break;
   }
-  st.tetrahedra_left = thinner.Tetrahedra().size();
-  if (st.tetrahedra_left > 0)
-    monitor.Warn(Count(st.tetrahedra_left, "closed tetrahedra are left: none of their face pairs shares a manifold edge"));
-  if (st.small_components_left > 0)
-    monitor.Warn(Count(st.small_components_left, "small components are left: removing them would open a hole"));
 }
 
 // A Thinner over `faces`, with their centroids' UDF values (the order of removals) and the layer test of
@@ -444,6 +546,18 @@ TriangleMesh ThinMesh(const Udf& udf, const TriangleMesh& thick, const ThinMeshO
                Count(st.duplicate_faces, "duplicate faces"));
   Thinner thinner = MakeThinner(udf, thick.vertices, std::move(faces), options);
   PaperThinning(thinner, options, st, monitor);
+  if (options.thinning != "paper" && options.shell_rings > 0) {
+    // 3b. Closed shells that no pair or component removal could thin (local_shells: each opened at one face).
+    st.shells_opened = thinner.OpenLocalShells(options.shell_rings);
+    monitor.Info(Count(st.shells_opened, "closed shells opened (one face off the surface removed from each)"));
+  }
+  st.tetrahedra_left = thinner.Tetrahedra().size();
+  if (st.tetrahedra_left > 0)
+    monitor.Warn(Count(st.tetrahedra_left, "closed tetrahedra are left: none of their face pairs shares a manifold edge") +
+                 (options.thinning != "paper" && options.shell_rings > 0 ? ", and none of their faces lies off the surface"
+                                                                          : ""));
+  if (st.small_components_left > 0)
+    monitor.Warn(Count(st.small_components_left, "small components are left: removing them would open a hole"));
   std::vector<Tri> kept = AliveFaces(thinner);
   if (options.thinning != "paper") {
     // 4. Junction gaps: cracks (T-junctions), then triangular holes and notches (close_holes.h).

@@ -32,6 +32,9 @@ struct ThinMeshOptions {
   /// --rim-flaps (not with --thinning paper): step 6 removes the faces that hang from a free edge across a
   /// non-manifold edge where every edge they leave with one face lies on a rim (no surface beyond it).
   bool rim_flaps = true;
+  /// --shell-rings (not with --thinning paper; 0: off): step 3b opens the closed shells that steps 1-3 leave
+  /// and whose faces lie within this many edges of one of their faces, at a face off the surface.
+  int shell_rings = 1;
 
   /// Throws UsageError for values that cannot work.
   void Check() const;
@@ -44,6 +47,7 @@ struct ThinMeshStats {
   size_t tetrahedra = 0;            ///< closed tetrahedra found (first round)
   size_t tetrahedra_thinned = 0;    ///< of those, the ones a face pair was removed from
   size_t tetrahedra_left = 0;       ///< closed tetrahedra at the end (no pair on a manifold edge)
+  size_t shells_opened = 0;         ///< step 3b: closed shells opened, one face removed from each
   size_t components_removed = 0;    ///< small components removed
   size_t component_faces_removed = 0;
   size_t small_components_left = 0; ///< small components whose removal would have opened a hole
@@ -70,6 +74,11 @@ struct ThinMeshStats {
 ///     unless thinning is "paper", when it has a free edge or is a layer (layer_angle_deg);
 ///     largest mean centroid UDF first (Fig. 8's rule), repeated until none can go.
 ///  3. Steps 1-2 repeat until neither changes the mesh.
+///  3b. Unless thinning is "paper" or shell_rings is 0: the closed shells left (tetrahedra whose edges all
+///     carry a third face, bubbles of more faces) within shell_rings edges of one of their faces are opened
+///     at a face off the surface (centroid UDF above 0.1 x its longest edge), the largest centroid UDF
+///     first: each removal lowers b2 by one and leaves b0 and b1 as they were. Shells whose faces all lie
+///     on the surface (cavities) stay.
 ///  4. Unless thinning is "paper": SplitFacesOverCracks, then CloseTriangularHoles (close_holes.h).
 ///  5. Then, if step 4 changed anything: the closed tetrahedra (step 1's rule), and a small component (as in
 ///     step 2) that has a free edge is removed when that leaves no border edge with a single face and keeps
