@@ -294,6 +294,32 @@ TEST(ThinMesh, ANotchAtABranchingLineIsClosed) {
   ExpectGridWithWholeFin(out);
 }
 
+TEST(ThinMesh, ASheetFaceMissingBetweenTwoBranchingEdgesIsRestored) {
+  // The centre of three-discs: the origin and a point on each half-axis, and the twelve quadrant faces of
+  // the three discs, so every edge from the origin carries four. One quadrant face of z = 0, between -x
+  // and +y, is missing; its outer edge keeps the face beyond it: a free edge whose ends are joined to the
+  // origin by branching edges, each one sheet short.
+  TriangleMesh m;
+  m.vertices = {{0, 0, 0}, {0.1, 0, 0}, {-0.1, 0, 0}, {0, 0.1, 0}, {0, -0.1, 0}, {0, 0, 0.1}, {0, 0, -0.1}};
+  const int px = 1, nx = 2, py = 3, ny = 4, pz = 5, nz = 6;
+  const int quadrants[3][4] = {{px, py, nx, ny}, {px, pz, nx, nz}, {py, pz, ny, nz}};
+  for (const auto& q : quadrants)
+    for (int k = 0; k < 4; ++k) {
+      const int a = q[k], b = q[(k + 1) % 4];
+      if (!(a == py && b == nx)) m.faces.push_back({0, a, b});
+      m.faces.push_back({a, b, AddVertex(m, m.vertices[a] + m.vertices[b])});  // the quadrant beyond
+    }
+  const auto udf = MakeShape("three-discs");
+  ThinMeshOptions options = MinFaces(1);
+  const TriangleMesh out = ThinMesh(*udf, m, options, Monitor::Null());
+  EXPECT_TRUE(SortedFaces(out).count(SortedTri({0, nx, py})));
+  EXPECT_EQ(ComputeTopology(out).euler, 1) << "a disc-like patch, as around the centre of three-discs";
+  EXPECT_EQ(ComputeTopology(m).euler, 0);
+  // With --thinning paper the gap stays.
+  options.thinning = "paper";
+  EXPECT_FALSE(SortedFaces(ThinMesh(*udf, m, options, Monitor::Null())).count(SortedTri({0, nx, py})));
+}
+
 TEST(ThinMesh, AFaceOverACrackAtABranchingLineIsSplit) {
   const auto udf = MakeShape("disc");
   TriangleMesh m;

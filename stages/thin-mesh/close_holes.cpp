@@ -1,6 +1,7 @@
 #include "stages/thin-mesh/close_holes.h"
 
 #include <algorithm>
+#include <iterator>
 #include <map>
 #include <set>
 
@@ -101,6 +102,35 @@ size_t CloseTriangularHoles(const std::vector<Vec3>& vertices, std::vector<Tri>&
         faces.push_back(t);
         ++added;
       }
+  // A sheet's face missing at a branching curve: a boundary edge (a, b) whose ends are both joined to a
+  // vertex m by branching edges (3+ faces). The hole (a, b, m) is bounded by one free edge and two edges of
+  // the curve, which the missing face leaves one sheet short; (a, b, m) closes it.
+  std::map<int, std::vector<int>> branching;  // vertex -> its neighbours along branching edges, sorted
+  for (const auto& [e, w] : fans.third)
+    if (w.size() >= 3) {
+      branching[e.first].push_back(e.second);
+      branching[e.second].push_back(e.first);
+    }
+  for (auto& [v, nb] : branching) std::sort(nb.begin(), nb.end());
+  std::set<EdgePair> closed;  // the free edges the faces above were given
+  for (size_t f = faces.size() - added; f < faces.size(); ++f)
+    for (int k = 0; k < 3; ++k)
+      closed.insert(KeyOf(faces[f][static_cast<size_t>(k)], faces[f][static_cast<size_t>((k + 1) % 3)]));
+  for (const auto& [e, w] : fans.third) {
+    if (w.size() != 1 || closed.count(e)) continue;
+    const auto ia = branching.find(e.first), ib = branching.find(e.second);
+    if (ia == branching.end() || ib == branching.end()) continue;
+    std::vector<int> common;
+    std::set_intersection(ia->second.begin(), ia->second.end(), ib->second.begin(), ib->second.end(),
+                          std::back_inserter(common));
+    for (int m : common) {
+      const Tri t = SortedTri({e.first, e.second, m});
+      if (!done.insert(t).second || !fans.Fits(vertices, e.first, e.second, m, min_quality, min_cos)) continue;
+      faces.push_back(t);
+      ++added;
+      break;  // one face per free edge
+    }
+  }
   return added;
 }
 

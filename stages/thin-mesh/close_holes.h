@@ -23,7 +23,9 @@ size_t SplitFacesOverCracks(const std::vector<Vec3>& vertices, std::vector<Tri>&
 /// face) to a and to c and the third side a-c is an edge too, either a boundary edge (a hole of one
 /// triangle) or one with faces (a notch next to a branching curve: a sheet's face missing there), unless
 /// the triangle is degenerate or would lie over a face of one of its edges (at an open rim, three
-/// consecutive rim vertices: the face already there). Returns the number of faces added (appended).
+/// consecutive rim vertices: the face already there). Then, with the same tests, the face (a, b, m) for a
+/// boundary edge (a, b) not closed so whose ends are both joined to m by branching edges (3+ faces): a
+/// sheet's face missing between the free edge and the curve. Returns the number of faces added (appended).
 size_t CloseTriangularHoles(const std::vector<Vec3>& vertices, std::vector<Tri>& faces, double min_quality,
                             double min_cos);
 
