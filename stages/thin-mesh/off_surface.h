@@ -1,6 +1,7 @@
 #pragma once
 // The one test thin-mesh uses to tell a face that spans between sheets, or across a bubble, from a face of
-// the surface: its centroid's UDF against its size. Shared by step 3b (local_shells) and step 6 (rim_flaps).
+// the surface: its centroid's UDF against its size. Shared by step 3b (thin_mesh.cpp, OpenLocalShells) and
+// step 6 (rim_flaps).
 #include <algorithm>
 
 #include "common/types.h"
