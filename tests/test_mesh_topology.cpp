@@ -3,6 +3,7 @@
 
 #include <cmath>
 
+#include "common/face_cycles.h"
 #include "common/mesh_topology.h"
 
 namespace voroudf {
@@ -117,6 +118,33 @@ TEST(MeshTopology, CanonicalOrderDependsOnTheGeometryAlone) {
   EXPECT_EQ(ca.faces, cb.faces);
   EXPECT_EQ(ComputeTopology(ca).euler, 2);
   EXPECT_EQ(ca.vertices[0], Vec3(0, 0, 0));
+}
+
+TEST(FaceComplex, FacesOfAClosedShellLieOnATwoCycleUntilItIsOpened) {
+  // A tetrahedron on a flat fan: the shell's faces lie on a 2-cycle, the fan's do not.
+  const std::vector<Tri> faces = {{0, 1, 2}, {0, 1, 3}, {0, 2, 3}, {1, 2, 3}, {0, 1, 4}, {0, 4, 5}};
+  FaceComplex c(faces);
+  for (int f = 0; f < 4; ++f) EXPECT_TRUE(c.OnLocalTwoCycle(f, 1)) << f;
+  EXPECT_FALSE(c.OnLocalTwoCycle(4, 1));
+  EXPECT_FALSE(c.OnLocalTwoCycle(5, 1));
+  EXPECT_TRUE(c.HasFreeEdge(5));
+  EXPECT_FALSE(c.HasFreeEdge(0));
+  c.Remove(2);  // opened: no face of it is on a cycle any more, and (1, 2, 3) now has a free edge
+  for (int f : {0, 1, 3}) EXPECT_FALSE(c.OnLocalTwoCycle(f, 1)) << f;
+  EXPECT_TRUE(c.HasFreeEdge(3));
+  // A shell wider than the rings searched is not seen: an octahedron from one face, at 0 rings (the face's
+  // own vertices only), and seen at 1.
+  const std::vector<Tri> octahedron = {{0, 2, 4}, {2, 1, 4}, {1, 3, 4}, {3, 0, 4},
+                                       {2, 0, 5}, {1, 2, 5}, {3, 1, 5}, {0, 3, 5}};
+  const FaceComplex o(octahedron);
+  EXPECT_FALSE(o.OnLocalTwoCycle(0, 0));
+  EXPECT_TRUE(o.OnLocalTwoCycle(0, 1));
+}
+
+TEST(FaceComplex, Gf2SpanOfEdgeSets) {
+  EXPECT_TRUE(InGf2Span({0, 1, 2}, {{0, 3, 4}, {1, 3, 5}, {2, 4, 5}}));  // the other three faces of a tetrahedron
+  EXPECT_FALSE(InGf2Span({0, 1, 2}, {{0, 3, 4}, {1, 3, 5}}));
+  EXPECT_FALSE(InGf2Span({0, 1, 2}, {}));
 }
 
 }  // namespace

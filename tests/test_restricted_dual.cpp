@@ -69,7 +69,40 @@ TEST(RestrictedDual, ATriangleSpanningASeedOnItsEdgeIsNotKept) {
   const std::vector<Tri> witnessed = {{1, 2, 5}, {1, 3, 5}, {2, 3, 5}, {0, 1, 5}, {3, 4, 5}, {1, 2, 3}};
   const std::vector<Tri> out =
       LocallyDelaunayTriples(p, std::vector<Vec3>(6, Vec3(0, 0, 1)), std::vector<uint8_t>(6, 1), witnessed, 25.0, nullptr);
-  EXPECT_EQ(out, (std::vector<Tri>{{1, 2, 5}, {2, 3, 5}, {0, 1, 5}, {3, 4, 5}})) << "and (1, 2, 3) is collinear";
+  EXPECT_EQ(out, (std::vector<Tri>{{0, 1, 5}, {1, 2, 5}, {2, 3, 5}, {3, 4, 5}})) << "and (1, 2, 3) is collinear";
+}
+
+TEST(RestrictedDual, ABlockedTriangleWhoseReplacementWasNotWitnessedIsReplacedNotDropped) {
+  // A flat fan around seed 0 (seeds 1..6 on a hexagon) and seed 7 inside its face (0, 1, 2), which 7
+  // blocks. Of the three triangles that replace (0, 1, 2), (0, 1, 7) and (1, 2, 7) were witnessed but not
+  // (0, 2, 7): dropping (0, 1, 2) would open a hole there.
+  std::vector<Vec3> p = {{0, 0, 0}};
+  for (int k = 0; k < 6; ++k) p.emplace_back(std::cos(k * M_PI / 3), std::sin(k * M_PI / 3), 0.0);
+  p.push_back((p[0] + p[1] + p[2]) / 3.0);  // 7
+  std::vector<Tri> witnessed;
+  for (int k = 1; k <= 6; ++k) witnessed.push_back(SortedTri({0, k, k % 6 + 1}));
+  witnessed.push_back({0, 1, 7});
+  witnessed.push_back({1, 2, 7});
+  std::sort(witnessed.begin(), witnessed.end());
+  const std::vector<Vec3> normals(8, Vec3(0, 0, 1));
+  const std::vector<uint8_t> on_sheet(8, 1);
+  RestrictedDualStats stats;
+  const std::vector<Tri> out = LocallyDelaunayTriples(p, normals, on_sheet, witnessed, 25.0, &stats);
+  const std::set<Tri> got(out.begin(), out.end());
+  EXPECT_FALSE(got.count({0, 1, 2})) << "not Delaunay";
+  EXPECT_TRUE(got.count({0, 1, 7}) && got.count({1, 2, 7}) && got.count({0, 2, 7})) << "its replacement with 7";
+  EXPECT_EQ(stats.replaced, 1u);
+  EXPECT_EQ(stats.added, 1u);
+  const TopologyStats topo = ComputeTopology(TriangleMesh{p, out});
+  EXPECT_EQ(topo.euler, 1) << "a disc, no hole";
+  EXPECT_EQ(topo.boundary_edges, 6u);
+  EXPECT_EQ(topo.nonmanifold_edges, 0u);
+  // With (0, 2, 7) witnessed too, (0, 1, 2) closes a shell with its replacement and is simply dropped.
+  witnessed.push_back({0, 2, 7});
+  std::sort(witnessed.begin(), witnessed.end());
+  const std::vector<Tri> out2 = LocallyDelaunayTriples(p, normals, on_sheet, witnessed, 25.0, &stats);
+  EXPECT_EQ(stats.replaced, 0u);
+  EXPECT_EQ(std::set<Tri>(out2.begin(), out2.end()), got);
 }
 
 // Two curve seeds 0, 1 on the line where the planes z = 0 and x = 0 cross, and a sheet seed on each of the

@@ -11,6 +11,7 @@
 #include <unordered_set>
 #include <utility>
 
+#include "common/face_cycles.h"
 #include "common/mesh_topology.h"
 
 namespace voroudf {
@@ -29,6 +30,27 @@ bool InCircumcircle(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& p, 
                      C.squaredNorm() * (A.x() * B.y() - A.y() * B.x());
   const double scale = std::max({A.squaredNorm(), B.squaredNorm(), C.squaredNorm()});
   return det * (orient > 0 ? 1 : -1) > cocircular * scale * std::abs(orient);
+}
+
+// The Delaunay triangulation of a triangle (i, j, k) and a seed v inside its circumcircle, in the chart: with
+// v inside the triangle, the three triangles from v; with v beyond (or on) the edge (p, q) opposite r, the
+// flip (r, p, v), (r, v, q). Each sorted.
+std::vector<Tri> DelaunayReplacement(const Tri& t, int v, const Vec3& chart, const std::vector<Vec3>& seeds) {
+  const Vec3 u = chart.unitOrthogonal(), w = chart.cross(u).normalized();
+  auto flat = [&](int q) {
+    const Vec3& x = seeds[static_cast<size_t>(q)];
+    return Eigen::Vector2d(x.dot(u), x.dot(w));
+  };
+  auto side = [&](int p, int q, int r) {  // orientation of (p, q, r) in the chart
+    const Eigen::Vector2d P = flat(p), Q = flat(q), R = flat(r);
+    return (Q - P).x() * (R - P).y() - (Q - P).y() * (R - P).x();
+  };
+  const double whole = side(t[0], t[1], t[2]);
+  for (int k = 0; k < 3; ++k) {
+    const int p = t[static_cast<size_t>(k)], q = t[static_cast<size_t>((k + 1) % 3)], r = t[static_cast<size_t>((k + 2) % 3)];
+    if (side(p, q, v) * whole <= 0.0) return {SortedTri({r, p, v}), SortedTri({r, v, q})};
+  }
+  return {SortedTri({t[0], t[1], v}), SortedTri({t[1], t[2], v}), SortedTri({t[2], t[0], v})};
 }
 
 // The chart of four seeds, the plane their junction is triangulated in: the best-fit plane of the four,
@@ -242,7 +264,9 @@ std::vector<Tri> LocallyDelaunayTriples(const std::vector<Vec3>& seeds, const st
   constexpr double kCocircular = 1e-9;
   constexpr double kMaxFlatness = 0.25;
   const double min_cos = std::cos(chart_angle_deg * M_PI / 180.0);
-  std::vector<Tri> kept;
+  std::vector<Tri> candidates;  // the non-collinear triples, with whether a fourth seed blocks them
+  std::vector<char> blocked_by;
+  std::vector<std::pair<int, Vec3>> blocker;  // per candidate: the blocking seed and the chart (-1: none)
   std::vector<int> common, both;
   for (const Tri& t : witnessed) {
     const Vec3 &a = seeds[static_cast<size_t>(t[0])], &b = seeds[static_cast<size_t>(t[1])], &c = seeds[static_cast<size_t>(t[2])];
@@ -260,17 +284,54 @@ std::vector<Tri> LocallyDelaunayTriples(const std::vector<Vec3>& seeds, const st
     common.clear();
     std::set_intersection(both.begin(), both.end(), n2.begin(), n2.end(), std::back_inserter(common));
     bool blocked = false;
+    std::pair<int, Vec3> by{-1, Vec3::Zero()};
     for (int v : common) {
       if (v == t[0] || v == t[1] || v == t[2]) continue;
       const Vec3 chart = ChartNormal({t[0], t[1], t[2], v}, seeds, normals, on_sheet, min_cos, kMaxFlatness);
       if (chart.isZero()) continue;
       if (InCircumcircle(a, b, c, seeds[static_cast<size_t>(v)], chart, kCocircular)) {
         blocked = true;
+        by = {v, chart};
         break;
       }
     }
-    if (!blocked) kept.push_back(t);
+    candidates.push_back(t);
+    blocked_by.push_back(blocked ? 1 : 0);
+    blocker.push_back(by);
   }
+  // The hole guard: a blocked triple goes where that opens no hole — it lies on a closed shell of the
+  // triples left (its Delaunay replacements are there: b2 falls) or has a free edge (a collapse). A removal
+  // can free another blocked triple (an edge left to it alone), so passes repeat until none goes. Where a
+  // blocked triple would open a hole, the triangles that replace it were never witnessed: its Delaunay
+  // replacement with the seed that blocks it takes its place (DelaunayReplacement).
+  FaceComplex complex(candidates);
+  for (bool removed = true; removed;) {
+    removed = false;
+    for (size_t f = 0; f < candidates.size(); ++f) {
+      const int g = static_cast<int>(f);
+      if (blocked_by[f] && complex.present(g) && (complex.HasFreeEdge(g) || complex.OnLocalTwoCycle(g, 1))) {
+        complex.Remove(g);
+        removed = true;
+      }
+    }
+  }
+  std::vector<Tri> kept;
+  std::unordered_set<Tri, TriHash> have;
+  for (size_t f = 0; f < candidates.size(); ++f)
+    if (complex.present(static_cast<int>(f)) && !blocked_by[f]) {
+      kept.push_back(candidates[f]);
+      have.insert(candidates[f]);
+    }
+  for (size_t f = 0; f < candidates.size(); ++f) {
+    if (!blocked_by[f] || !complex.present(static_cast<int>(f))) continue;
+    ++stats.replaced;
+    for (const Tri& r : DelaunayReplacement(candidates[f], blocker[f].first, blocker[f].second, seeds))
+      if (have.insert(r).second) {
+        kept.push_back(r);
+        ++stats.added;
+      }
+  }
+  std::sort(kept.begin(), kept.end());
   stats.kept = kept.size();
   if (stats_out) *stats_out = stats;
   return kept;

@@ -11,8 +11,10 @@ namespace voroudf {
 
 struct RestrictedDualStats {
   size_t witnessed = 0;     ///< witnessed triples given
-  size_t kept = 0;          ///< of those, locally Delaunay (kept)
+  size_t kept = 0;          ///< triples returned: the locally Delaunay ones and the hole guard's replacements
   size_t degenerate = 0;    ///< of those, collinear seeds (no circumsphere): dropped
+  size_t replaced = 0;      ///< blocked triples whose removal would open a hole, replaced (hole guard)
+  size_t added = 0;         ///< triangles their Delaunay replacements added (not witnessed)
 };
 
 /// The locally Delaunay witnessed triples. A witnessed triple (i, j, k) — three seeds whose geodesic
@@ -33,11 +35,19 @@ struct RestrictedDualStats {
 /// block; and only seeds with the triangle on one chart, so a crease's other face never blocks.
 /// Four seeds exactly on one circle do not block each other: both triangulations stay, thin-mesh chooses.
 ///
+/// Hole guard: a blocked triple is removed only where that opens no hole — where it lies on a closed shell of
+/// the triples left (FaceComplex::OnLocalTwoCycle, one ring: its Delaunay replacements were witnessed, and
+/// b2 falls) or has an edge no other triple covers (a collapse); passes repeat until none goes. Where it
+/// would open a hole (its replacements were never witnessed: near a branching curve the dense samples see
+/// fewer of a junction's regions), the Delaunay triangulation of it and the seed that blocks it, in their
+/// chart, takes its place. **Invariant:** the filter lowers b2 and never raises b1 over the witnessed
+/// triples, except through the replacements, which cover the same part of the chart.
+///
 /// \param seeds      seed positions
 /// \param normals    a unit surface normal (UDF gradient) per seed, either orientation; zero: no chart
 /// \param on_sheet   per seed, whether it lies on a sheet (rank 1 or unknown): only those normals count
 /// \param witnessed  triples of seed indices, each vertex triple once, indices sorted
-/// \returns the kept triples in the order given (collinear triples are dropped)
+/// \returns the kept triples, sorted (collinear triples are dropped)
 std::vector<Tri> LocallyDelaunayTriples(const std::vector<Vec3>& seeds, const std::vector<Vec3>& normals,
                                         const std::vector<uint8_t>& on_sheet, const std::vector<Tri>& witnessed,
                                         double chart_angle_deg, RestrictedDualStats* stats);

@@ -13,6 +13,7 @@
 #include <unordered_set>
 
 #include "common/errors.h"
+#include "common/face_cycles.h"
 #include "common/mesh_topology.h"
 #include "common/union_find.h"
 #include "stages/thin-mesh/close_holes.h"
@@ -21,46 +22,6 @@
 
 namespace voroudf {
 namespace {
-
-/// Whether the edge set `target` (a face's three edges) is, over GF(2), a sum of the edge sets `rows`:
-/// Gaussian elimination on bitsets over the edges that occur, each row reduced against an echelon basis
-/// keyed by its leading bit. Written by hand: the sets are tens of faces, and Eigen has no GF(2) solver.
-bool InGf2Span(const std::array<int, 3>& target, const std::vector<std::array<int, 3>>& rows) {
-  std::unordered_map<int, int> column;
-  for (int e : target) column.emplace(e, static_cast<int>(column.size()));
-  for (const auto& r : rows)
-    for (int e : r) column.emplace(e, static_cast<int>(column.size()));
-  const size_t words = (column.size() + 63) / 64;
-  auto bits = [&](const std::array<int, 3>& edges) {
-    std::vector<uint64_t> row(words, 0);
-    for (int e : edges) {
-      const int c = column.at(e);
-      row[static_cast<size_t>(c / 64)] ^= uint64_t{1} << (c % 64);
-    }
-    return row;
-  };
-  auto lead = [&](const std::vector<uint64_t>& row) {
-    for (size_t w = words; w-- > 0;)
-      if (row[w]) return static_cast<int>(w * 64 + 63) - __builtin_clzll(row[w]);
-    return -1;
-  };
-  std::unordered_map<int, std::vector<uint64_t>> basis;
-  auto reduce = [&](std::vector<uint64_t>& row) {  // to zero (returns -1) or to a new leading bit
-    for (int l = lead(row); l >= 0; l = lead(row)) {
-      const auto it = basis.find(l);
-      if (it == basis.end()) return l;
-      for (size_t w = 0; w < words; ++w) row[w] ^= it->second[w];
-    }
-    return -1;
-  };
-  for (const auto& r : rows) {
-    std::vector<uint64_t> row = bits(r);
-    const int l = reduce(row);
-    if (l >= 0) basis.emplace(l, std::move(row));
-  }
-  std::vector<uint64_t> t = bits(target);
-  return reduce(t) < 0;
-}
 
 /// The mutable state of the thinning: faces, which are still present, and the valence of every edge.
 class Thinner {
@@ -182,10 +143,9 @@ class Thinner {
   /// Returns the faces removed.
   size_t OpenLocalShells(int rings) {
     if (!vertices_) return 0;
-    std::vector<std::vector<int>> vertex_faces(vertex_faces_.size());
+    FaceComplex complex(faces_);
     for (size_t g = 0; g < faces_.size(); ++g)
-      if (alive_[g])
-        for (int v : faces_[g]) vertex_faces[static_cast<size_t>(v)].push_back(static_cast<int>(g));
+      if (!alive_[g]) complex.Remove(static_cast<int>(g));
     std::vector<int> order;
     for (size_t g = 0; g < faces_.size(); ++g)
       if (alive_[g]) order.push_back(static_cast<int>(g));
@@ -197,9 +157,10 @@ class Thinner {
       const std::vector<Vec3>& p = *vertices_;
       if (!OffSurface(udf_[static_cast<size_t>(g)], p[static_cast<size_t>(t[0])], p[static_cast<size_t>(t[1])],
                       p[static_cast<size_t>(t[2])]) ||
-          !OnLocalShell(g, rings, vertex_faces))
+          !complex.OnLocalTwoCycle(g, rings))
         continue;
       Remove(g);
+      complex.Remove(g);
       ++opened;
     }
     return opened;
@@ -350,37 +311,6 @@ class Thinner {
   }
 
  private:
-  /// Whether face `f` lies on a 2-cycle of present faces whose vertices are all within `rings` edges of f's:
-  /// whether f's boundary is in the GF(2) span of the boundaries of those other faces.
-  bool OnLocalShell(int f, int rings, const std::vector<std::vector<int>>& vertex_faces) const {
-    for (int e : face_edges_[static_cast<size_t>(f)])
-      if (valence_[static_cast<size_t>(e)] < 2) return false;  // a free edge is on no 2-cycle
-    const Tri& tf = faces_[static_cast<size_t>(f)];
-    std::unordered_set<int> near(tf.begin(), tf.end());
-    std::vector<int> frontier(tf.begin(), tf.end());
-    for (int r = 0; r < rings; ++r) {
-      std::vector<int> next;
-      for (int v : frontier)
-        for (int g : vertex_faces[static_cast<size_t>(v)])
-          if (alive_[static_cast<size_t>(g)])
-            for (int w : faces_[static_cast<size_t>(g)])
-              if (near.insert(w).second) next.push_back(w);
-      frontier.swap(next);
-    }
-    std::vector<int> local;  // present faces other than f with every vertex near f
-    for (int v : near)
-      for (int g : vertex_faces[static_cast<size_t>(v)]) {
-        const Tri& t = faces_[static_cast<size_t>(g)];
-        if (g != f && alive_[static_cast<size_t>(g)] && near.count(t[0]) && near.count(t[1]) && near.count(t[2]))
-          local.push_back(g);
-      }
-    std::sort(local.begin(), local.end());
-    local.erase(std::unique(local.begin(), local.end()), local.end());
-    std::vector<std::array<int, 3>> rows;
-    for (int g : local) rows.push_back(face_edges_[static_cast<size_t>(g)]);
-    return InGf2Span(face_edges_[static_cast<size_t>(f)], rows);
-  }
-
   int Present(const Tri& sorted) const {
     const auto it = by_vertices_.find(sorted);
     return it != by_vertices_.end() && alive_[static_cast<size_t>(it->second)] ? it->second : -1;
