@@ -72,10 +72,10 @@ TEST(RestrictedDual, ATriangleSpanningASeedOnItsEdgeIsNotKept) {
   EXPECT_EQ(out, (std::vector<Tri>{{0, 1, 5}, {1, 2, 5}, {2, 3, 5}, {3, 4, 5}})) << "and (1, 2, 3) is collinear";
 }
 
-TEST(RestrictedDual, ABlockedTriangleWhoseReplacementWasNotWitnessedIsReplacedNotDropped) {
+TEST(RestrictedDual, ABlockedTriangleWhoseRemovalWouldOpenAHoleStaysOrIsFlippedAtAChain) {
   // A flat fan around seed 0 (seeds 1..6 on a hexagon) and seed 7 inside its face (0, 1, 2), which 7
   // blocks. Of the three triangles that replace (0, 1, 2), (0, 1, 7) and (1, 2, 7) were witnessed but not
-  // (0, 2, 7): dropping (0, 1, 2) would open a hole there.
+  // (0, 2, 7): dropping (0, 1, 2) would open a hole there, so it stays.
   std::vector<Vec3> p = {{0, 0, 0}};
   for (int k = 0; k < 6; ++k) p.emplace_back(std::cos(k * M_PI / 3), std::sin(k * M_PI / 3), 0.0);
   p.push_back((p[0] + p[1] + p[2]) / 3.0);  // 7
@@ -85,24 +85,32 @@ TEST(RestrictedDual, ABlockedTriangleWhoseReplacementWasNotWitnessedIsReplacedNo
   witnessed.push_back({1, 2, 7});
   std::sort(witnessed.begin(), witnessed.end());
   const std::vector<Vec3> normals(8, Vec3(0, 0, 1));
-  const std::vector<uint8_t> on_sheet(8, 1);
+  std::vector<uint8_t> on_sheet(8, 1);
   RestrictedDualStats stats;
   const std::vector<Tri> out = LocallyDelaunayTriples(p, normals, on_sheet, witnessed, 25.0, &stats);
-  const std::set<Tri> got(out.begin(), out.end());
-  EXPECT_FALSE(got.count({0, 1, 2})) << "not Delaunay";
-  EXPECT_TRUE(got.count({0, 1, 7}) && got.count({1, 2, 7}) && got.count({0, 2, 7})) << "its replacement with 7";
-  EXPECT_EQ(stats.replaced, 1u);
-  EXPECT_EQ(stats.added, 1u);
-  const TopologyStats topo = ComputeTopology(TriangleMesh{p, out});
-  EXPECT_EQ(topo.euler, 1) << "a disc, no hole";
-  EXPECT_EQ(topo.boundary_edges, 6u);
-  EXPECT_EQ(topo.nonmanifold_edges, 0u);
-  // With (0, 2, 7) witnessed too, (0, 1, 2) closes a shell with its replacement and is simply dropped.
+  EXPECT_EQ(out, witnessed) << "(0, 1, 2) is not Delaunay, but the only face there";
+  EXPECT_EQ(stats.kept_against_holes, 1u);
+  // With (0, 2, 7) witnessed too, (0, 1, 2) closes a shell with its replacement and is dropped.
   witnessed.push_back({0, 2, 7});
   std::sort(witnessed.begin(), witnessed.end());
   const std::vector<Tri> out2 = LocallyDelaunayTriples(p, normals, on_sheet, witnessed, 25.0, &stats);
-  EXPECT_EQ(stats.replaced, 0u);
-  EXPECT_EQ(std::set<Tri>(out2.begin(), out2.end()), got);
+  EXPECT_EQ(stats.kept_against_holes, 0u);
+  EXPECT_FALSE(std::set<Tri>(out2.begin(), out2.end()).count({0, 1, 2}));
+  const TopologyStats topo = ComputeTopology(TriangleMesh{p, out2});
+  EXPECT_EQ(topo.euler, 1) << "a disc";
+  EXPECT_EQ(topo.nonmanifold_edges, 0u);
+
+  // A chain 0 - 1 - 2 of feature seeds on the x axis, a sheet seed 3 above and 4 below, 5 beyond 2-3. The
+  // triangles (0, 2, 3) and (0, 2, 4) jump seed 1, which blocks them; of the flip of (0, 2, 3), only
+  // (0, 1, 3) was witnessed. Kept, it would leave a branching edge off the chain: the flips replace both.
+  const std::vector<Vec3> q = {{-0.1, 0, 0}, {0, 0, 0}, {0.1, 0, 0}, {0, 0.08, 0}, {0, -0.08, 0}, {0.15, 0.1, 0}};
+  const std::vector<Tri> chain = {{0, 1, 3}, {0, 1, 4}, {0, 2, 3}, {0, 2, 4}, {1, 2, 4}, {2, 3, 5}};
+  const std::vector<uint8_t> sheet = {0, 0, 0, 1, 1, 1};
+  const std::vector<Tri> flipped = LocallyDelaunayTriples(q, std::vector<Vec3>(6, Vec3(0, 0, 1)), sheet, chain, 25.0, &stats);
+  EXPECT_EQ(flipped, (std::vector<Tri>{{0, 1, 3}, {0, 1, 4}, {1, 2, 3}, {1, 2, 4}, {2, 3, 5}}));
+  EXPECT_EQ(stats.replaced, 2u);
+  EXPECT_EQ(stats.added, 1u);
+  EXPECT_EQ(stats.kept_against_holes, 0u);
 }
 
 // Two curve seeds 0, 1 on the line where the planes z = 0 and x = 0 cross, and a sheet seed on each of the

@@ -557,9 +557,9 @@ GvdResult BuildGvd(const Udf& udf, const SeedCloud& seeds, const BuildGvdOptions
     // A seed optimize-seeds put on a feature (rank 2 or 3) has no say either, even with a flat region.
     for (size_t i = 0; i < num_seeds; ++i) on_sheet[i] = on_sheet[i] && seeds.rank[i] <= kRankSheet;
     faces = LocallyDelaunayTriples(seeds.position, seed_normal, on_sheet, faces, options.chart_angle_deg, &rd);
-    monitor.Info(Format("locally Delaunay: %zu triples of %zu witnessed (%zu collinear; %zu whose removal would open a "
-                        "hole replaced by their Delaunay triangles, %zu of those new)",
-                        rd.kept, rd.witnessed, rd.degenerate, rd.replaced, rd.added));
+    monitor.Info(Format("locally Delaunay: %zu triples of %zu witnessed (%zu collinear; of those whose removal would open "
+                        "a hole, %zu kept and %zu jumping a feature seed flipped, %zu triangles new)",
+                        rd.kept, rd.witnessed, rd.degenerate, rd.kept_against_holes, rd.replaced, rd.added));
     if (options.chain_links) {
       std::vector<uint8_t> is_curve(num_seeds);
       for (size_t i = 0; i < num_seeds; ++i) is_curve[i] = IsCurveSeed(seeds, i);

@@ -302,8 +302,8 @@ std::vector<Tri> LocallyDelaunayTriples(const std::vector<Vec3>& seeds, const st
   // The hole guard: a blocked triple goes where that opens no hole — it lies on a closed shell of the
   // triples left (its Delaunay replacements are there: b2 falls) or has a free edge (a collapse). A removal
   // can free another blocked triple (an edge left to it alone), so passes repeat until none goes. Where a
-  // blocked triple would open a hole, the triangles that replace it were never witnessed: its Delaunay
-  // replacement with the seed that blocks it takes its place (DelaunayReplacement).
+  // blocked triple would open a hole, the triangles that replace it were never witnessed, and it stays;
+  // unless it jumps a feature seed along a chain, where its Delaunay flip through that seed replaces it.
   FaceComplex complex(candidates);
   for (bool removed = true; removed;) {
     removed = false;
@@ -324,8 +324,26 @@ std::vector<Tri> LocallyDelaunayTriples(const std::vector<Vec3>& seeds, const st
     }
   for (size_t f = 0; f < candidates.size(); ++f) {
     if (!blocked_by[f] || !complex.present(static_cast<int>(f))) continue;
+    const Tri& t = candidates[f];
+    const int v = blocker[f].first;
+    const std::vector<Tri> flip = DelaunayReplacement(t, v, blocker[f].second, seeds);
+    // A jump: the blocker is a feature seed beyond (or on) an edge of two feature seeds, so the triangle spans
+    // it along a chain. The two vertices of that edge are each in one triangle of the flip.
+    bool jump = flip.size() == 2 && !on_sheet[static_cast<size_t>(v)];
+    for (int x : t) {
+      const int in = static_cast<int>(std::count_if(flip.begin(), flip.end(), [&](const Tri& r) {
+        return std::find(r.begin(), r.end(), x) != r.end();
+      }));
+      jump = jump && !(in == 1 && on_sheet[static_cast<size_t>(x)]);
+    }
+    if (!jump) {  // better a triangle that is not Delaunay than a hole
+      ++stats.kept_against_holes;
+      kept.push_back(t);
+      have.insert(t);
+      continue;
+    }
     ++stats.replaced;
-    for (const Tri& r : DelaunayReplacement(candidates[f], blocker[f].first, blocker[f].second, seeds))
+    for (const Tri& r : flip)
       if (have.insert(r).second) {
         kept.push_back(r);
         ++stats.added;

@@ -13,8 +13,9 @@ struct RestrictedDualStats {
   size_t witnessed = 0;     ///< witnessed triples given
   size_t kept = 0;          ///< triples returned: the locally Delaunay ones and the hole guard's replacements
   size_t degenerate = 0;    ///< of those, collinear seeds (no circumsphere): dropped
-  size_t replaced = 0;      ///< blocked triples whose removal would open a hole, replaced (hole guard)
-  size_t added = 0;         ///< triangles their Delaunay replacements added (not witnessed)
+  size_t kept_against_holes = 0;  ///< blocked triples kept: removing them would open a hole (hole guard)
+  size_t replaced = 0;      ///< blocked triples that would open a hole and jump a feature seed: flipped
+  size_t added = 0;         ///< triangles those flips added (not witnessed)
 };
 
 /// The locally Delaunay witnessed triples. A witnessed triple (i, j, k) — three seeds whose geodesic
@@ -39,9 +40,10 @@ struct RestrictedDualStats {
 /// the triples left (FaceComplex::OnLocalTwoCycle, one ring: its Delaunay replacements were witnessed, and
 /// b2 falls) or has an edge no other triple covers (a collapse); passes repeat until none goes. Where it
 /// would open a hole (its replacements were never witnessed: near a branching curve the dense samples see
-/// fewer of a junction's regions), the Delaunay triangulation of it and the seed that blocks it, in their
-/// chart, takes its place. **Invariant:** the filter lowers b2 and never raises b1 over the witnessed
-/// triples, except through the replacements, which cover the same part of the chart.
+/// fewer of a junction's regions) it stays — unless the seed that blocks it is a feature seed beyond an edge
+/// of two feature seeds (the triangle jumps it along a chain): then the Delaunay flip through that seed, in
+/// their chart, takes its place. **Invariant:** the filter lowers b2 and never raises b1 over the witnessed
+/// triples, except through the flips, which cover the same part of the chart.
 ///
 /// \param seeds      seed positions
 /// \param normals    a unit surface normal (UDF gradient) per seed, either orientation; zero: no chart
