@@ -5,6 +5,8 @@
 #include <unordered_map>
 #include <unordered_set>
 
+#include "common/mesh_topology.h"
+
 namespace voroudf {
 
 // Gaussian elimination on bitsets over the edges that occur, each row reduced against an echelon basis keyed

@@ -7,7 +7,6 @@
 #include <array>
 #include <vector>
 
-#include "common/mesh_topology.h"
 #include "common/types.h"
 
 namespace voroudf {
@@ -28,9 +27,6 @@ class FaceComplex {
   /// Whether present face f lies on a 2-cycle of present faces whose vertices are all within `rings` edges
   /// (over present faces) of f's vertices: f's edges are, over GF(2), the sum of those faces' edges.
   bool OnLocalTwoCycle(int f, int rings) const;
-  /// Present faces per edge, indexed as BuildEdgeFaces orders the edges.
-  const std::vector<int>& valence() const { return valence_; }
-  const std::array<int, 3>& face_edges(int f) const { return face_edges_[static_cast<size_t>(f)]; }
 
  private:
   std::vector<Tri> faces_;

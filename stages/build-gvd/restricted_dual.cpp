@@ -264,9 +264,8 @@ std::vector<Tri> LocallyDelaunayTriples(const std::vector<Vec3>& seeds, const st
   constexpr double kCocircular = 1e-9;
   constexpr double kMaxFlatness = 0.25;
   const double min_cos = std::cos(chart_angle_deg * M_PI / 180.0);
-  std::vector<Tri> candidates;  // the non-collinear triples, with whether a fourth seed blocks them
-  std::vector<char> blocked_by;
-  std::vector<std::pair<int, Vec3>> blocker;  // per candidate: the blocking seed and the chart (-1: none)
+  std::vector<Tri> candidates;  // the non-collinear triples
+  std::vector<std::pair<int, Vec3>> blocker;  // per candidate: the seed that blocks it and their chart (-1: none)
   std::vector<int> common, both;
   for (const Tri& t : witnessed) {
     const Vec3 &a = seeds[static_cast<size_t>(t[0])], &b = seeds[static_cast<size_t>(t[1])], &c = seeds[static_cast<size_t>(t[2])];
@@ -283,20 +282,17 @@ std::vector<Tri> LocallyDelaunayTriples(const std::vector<Vec3>& seeds, const st
     std::set_intersection(n0.begin(), n0.end(), n1.begin(), n1.end(), std::back_inserter(both));
     common.clear();
     std::set_intersection(both.begin(), both.end(), n2.begin(), n2.end(), std::back_inserter(common));
-    bool blocked = false;
     std::pair<int, Vec3> by{-1, Vec3::Zero()};
     for (int v : common) {
       if (v == t[0] || v == t[1] || v == t[2]) continue;
       const Vec3 chart = ChartNormal({t[0], t[1], t[2], v}, seeds, normals, on_sheet, min_cos, kMaxFlatness);
       if (chart.isZero()) continue;
       if (InCircumcircle(a, b, c, seeds[static_cast<size_t>(v)], chart, kCocircular)) {
-        blocked = true;
         by = {v, chart};
         break;
       }
     }
     candidates.push_back(t);
-    blocked_by.push_back(blocked ? 1 : 0);
     blocker.push_back(by);
   }
   // The hole guard: a blocked triple goes where that opens no hole — it lies on a closed shell of the
@@ -304,12 +300,13 @@ std::vector<Tri> LocallyDelaunayTriples(const std::vector<Vec3>& seeds, const st
   // can free another blocked triple (an edge left to it alone), so passes repeat until none goes. Where a
   // blocked triple would open a hole, the triangles that replace it were never witnessed, and it stays;
   // unless it jumps a feature seed along a chain, where its Delaunay flip through that seed replaces it.
+  auto blocked = [&](size_t f) { return blocker[f].first >= 0; };
   FaceComplex complex(candidates);
   for (bool removed = true; removed;) {
     removed = false;
     for (size_t f = 0; f < candidates.size(); ++f) {
       const int g = static_cast<int>(f);
-      if (blocked_by[f] && complex.present(g) && (complex.HasFreeEdge(g) || complex.OnLocalTwoCycle(g, 1))) {
+      if (blocked(f) && complex.present(g) && (complex.HasFreeEdge(g) || complex.OnLocalTwoCycle(g, 1))) {
         complex.Remove(g);
         removed = true;
       }
@@ -318,12 +315,12 @@ std::vector<Tri> LocallyDelaunayTriples(const std::vector<Vec3>& seeds, const st
   std::vector<Tri> kept;
   std::unordered_set<Tri, TriHash> have;
   for (size_t f = 0; f < candidates.size(); ++f)
-    if (complex.present(static_cast<int>(f)) && !blocked_by[f]) {
+    if (!blocked(f)) {
       kept.push_back(candidates[f]);
       have.insert(candidates[f]);
     }
   for (size_t f = 0; f < candidates.size(); ++f) {
-    if (!blocked_by[f] || !complex.present(static_cast<int>(f))) continue;
+    if (!blocked(f) || !complex.present(static_cast<int>(f))) continue;
     const Tri& t = candidates[f];
     const int v = blocker[f].first;
     const std::vector<Tri> flip = DelaunayReplacement(t, v, blocker[f].second, seeds);
@@ -338,8 +335,7 @@ std::vector<Tri> LocallyDelaunayTriples(const std::vector<Vec3>& seeds, const st
     }
     if (!jump) {  // better a triangle that is not Delaunay than a hole
       ++stats.kept_against_holes;
-      kept.push_back(t);
-      have.insert(t);
+      if (have.insert(t).second) kept.push_back(t);  // a flip above may have made it already
       continue;
     }
     ++stats.replaced;

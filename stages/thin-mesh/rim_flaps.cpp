@@ -36,7 +36,6 @@ bool OnRim(const Udf& udf, const std::vector<Vec3>& p, int a, int b, int inner) 
   return *std::min_element(d.begin(), d.end()) > 0.3 * radius;
 }
 
-
 }  // namespace
 
 size_t RemoveRimFlaps(const Udf& udf, const std::vector<Vec3>& v, std::vector<Tri>& faces) {

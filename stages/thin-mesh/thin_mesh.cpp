@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <cstdint>
 #include <cstdio>
 #include <functional>
 #include <map>
@@ -137,7 +136,7 @@ class Thinner {
   /// Step 3b: opens every closed shell of present faces that lies within `rings` edges of one of its faces
   /// and has a face off the surface (OffSurface), at the first such face in decreasing centroid UDF. Each
   /// face in that order is removed when it is off the surface and its boundary is, over GF(2), the sum of the
-  /// boundaries of the other present faces near it (OnLocalShell). Removing a face of a 2-cycle lowers b2 by
+  /// boundaries of the other present faces near it (FaceComplex::OnLocalTwoCycle). Removing a face of a 2-cycle lowers b2 by
   /// one and changes neither b0 nor b1, so no hole opens; removing faces only breaks cycles, so one pass
   /// finds them all. A shell whose faces all lie on the surface is a cavity of the surface and stays.
   /// Returns the faces removed.
@@ -477,7 +476,7 @@ TriangleMesh ThinMesh(const Udf& udf, const TriangleMesh& thick, const ThinMeshO
   Thinner thinner = MakeThinner(udf, thick.vertices, std::move(faces), options);
   PaperThinning(thinner, options, st, monitor);
   if (options.thinning != "paper" && options.shell_rings > 0) {
-    // 3b. Closed shells that no pair or component removal could thin (local_shells: each opened at one face).
+    // 3b. Closed shells that no pair or component removal could thin, each opened at one face.
     st.shells_opened = thinner.OpenLocalShells(options.shell_rings);
     monitor.Info(Count(st.shells_opened, "closed shells opened (one face off the surface removed from each)"));
   }
