@@ -8,6 +8,7 @@
 
 #include "common/errors.h"
 #include "common/mesh_topology.h"
+#include "common/mesh_udf.h"
 #include "common/shapes.h"
 #include "formats/labels_io.h"
 #include "formats/mesh_io.h"
@@ -221,6 +222,52 @@ TEST(BuildGvd, KeptEdgesHaveTheirMidpointWithinEpsUdf) {
   EXPECT_GT(long_kept, 0u);
 }
 
+// A closed plate [-0.4, 0.4]^2 x [-t/2, t/2] as a mesh UDF (12 triangles).
+std::unique_ptr<Udf> Plate(double t) {
+  TriangleMesh m;
+  for (int i = 0; i < 8; ++i)
+    m.vertices.push_back({(i & 1) ? 0.4 : -0.4, (i & 2) ? 0.4 : -0.4, (i & 4) ? 0.5 * t : -0.5 * t});
+  const int quads[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+  for (const auto& q : quads) {
+    m.faces.push_back({q[0], q[1], q[2]});
+    m.faces.push_back({q[0], q[2], q[3]});
+  }
+  return std::make_unique<MeshUdf>(std::move(m), "plate");
+}
+
+// Graph edges from the plate's top face to its bottom face, away from the rims.
+size_t EdgesThroughTheWall(const GvdResult& r, double t) {
+  size_t through = 0;
+  for (const auto& e : r.samples.edges) {
+    const Vec3& a = r.samples.position[static_cast<size_t>(e[0])];
+    const Vec3& b = r.samples.position[static_cast<size_t>(e[1])];
+    const bool inner = std::max({std::abs(a.x()), std::abs(a.y()), std::abs(b.x()), std::abs(b.y())}) < 0.3;
+    through += inner && std::abs(a.z() - b.z()) > 0.9 * t;
+  }
+  return through;
+}
+
+TEST(BuildGvd, TheGraphDoesNotCrossAWallThinnerThanItsReach) {
+  // The wall (t = 0.045) is thinner than twice eps_udf (here 0.05 x diagonal), so no midpoint rises far
+  // enough for the UDF test, and the graph's longest edges (30 samples per seed) are about 1.25 t, so the
+  // edges through the wall are too oblique to the faces' normals for the one-end test (|cos| > 0.97): only
+  // the both-ends test sees them (|cos| >= t / length > 0.8 at both ends).
+  const double t = 0.045;
+  const auto udf = Plate(t);
+  const SeedCloud seeds = Seeds(*udf, 200);
+  BuildGvdOptions o;
+  o.samples_per_seed = 30;
+  o.eps_udf_rel = 0.05;
+  o.eps_grad_both = 1.0;  // off
+  const GvdResult off = BuildGvd(*udf, seeds, o, true, Monitor::Null());
+  EXPECT_GT(EdgesThroughTheWall(off, t), 100u) << "the setting must put edges through the wall";
+  o.eps_grad_both = BuildGvdOptions{}.eps_grad_both;
+  const GvdResult on = BuildGvd(*udf, seeds, o, true, Monitor::Null());
+  EXPECT_EQ(EdgesThroughTheWall(on, t), 0u);
+  EXPECT_GT(on.stats.edges_pruned_grad, off.stats.edges_pruned_grad);
+  EXPECT_EQ(on.stats.unreached, 0u);  // each face stays connected to its own seeds
+}
+
 TEST(BuildGvd, SameResultWhateverTheThreadCount) {
   const auto udf = MakeShape("three-discs");
   const SeedCloud seeds = Seeds(*udf, 300);
@@ -243,6 +290,9 @@ TEST(BuildGvd, BadOptionsAndEmptySeedsAreRefused) {
   EXPECT_THROW(o.Check(), UsageError);
   o = BuildGvdOptions{};
   o.eps_grad = 0;
+  EXPECT_THROW(o.Check(), UsageError);
+  o = BuildGvdOptions{};
+  o.eps_grad_both = 1.5;
   EXPECT_THROW(o.Check(), UsageError);
   const auto udf = MakeShape("sphere");
   EXPECT_THROW(BuildGvd(*udf, SeedCloud{}, BuildGvdOptions{}, false, Monitor::Null()), InputError);

@@ -77,6 +77,7 @@ void BuildGvdOptions::Check() const {
   if (knn < 3 || knn > 200) throw UsageError("--knn must be in [3, 200]");
   if (!(eps_udf_rel > 0.0 && eps_udf_rel < 1.0)) throw UsageError("--eps-udf-rel must be in (0, 1)");
   if (!(eps_grad > 0.0 && eps_grad <= 1.0)) throw UsageError("--eps-grad must be in (0, 1]");
+  if (!(eps_grad_both > 0.0 && eps_grad_both <= 1.0)) throw UsageError("--eps-grad-both must be in (0, 1]");
   if (curve_samples != "tangent" && curve_samples != "ball") throw UsageError("--curve-samples must be tangent or ball");
   CheckRelativeProjection(proj_tol_rel, proj_floor_rel, proj_max_iters);
 }
@@ -358,7 +359,7 @@ Graph PrunedGraph(const Udf& udf, const std::vector<Vec3>& node, const std::vect
     const double len = dir.norm();
     if (len > 0.0) {
       const double ca = std::abs(node_n[a].dot(dir)) / len, cb = std::abs(node_n[b].dot(dir)) / len;
-      if (ca > options.eps_grad || cb > options.eps_grad) {
+      if (ca > options.eps_grad || cb > options.eps_grad || (ca > options.eps_grad_both && cb > options.eps_grad_both)) {
         ++pruned_grad;
         continue;
       }
@@ -390,8 +391,9 @@ Graph PrunedGraph(const Udf& udf, const std::vector<Vec3>& node, const std::vect
                 adj.begin() + static_cast<long>(offset[static_cast<size_t>(li) + 1]));
   }
   monitor.Info(Format("kNN graph (k=%d): %zu edges; pruned %zu with midpoint UDF > %.3g, %zu with |cos(edge, "
-                      "gradient)| > %.3g; %zu left",
-                      kk, stats.edges_knn, pruned_udf, eps_udf, pruned_grad, options.eps_grad, offset[n] / 2));
+                      "gradient)| > %.3g at an end or > %.3g at both; %zu left",
+                      kk, stats.edges_knn, pruned_udf, eps_udf, pruned_grad, options.eps_grad, options.eps_grad_both,
+                      offset[n] / 2));
   if (!with_edge_list) {  // only --graph writes them
     std::vector<std::pair<int, int>>().swap(edges);
     std::vector<char>().swap(keep);

@@ -38,6 +38,11 @@ struct BuildGvdOptions {
   double eps_udf_rel = 2e-3;
   /// An edge is pruned when |cos(edge, gradient)| at either endpoint exceeds this (--eps-grad).
   double eps_grad = 0.97;
+  /// An edge is also pruned when |cos(edge, gradient)| exceeds this at both endpoints (--eps-grad-both; 1: off):
+  /// it crosses a wall thinner than the graph's reach, from one sheet to the parallel one behind it. One end
+  /// on a crease or crossing carries the other face's normal, but the far end's normal is then across the
+  /// edge, so creases and crossings keep their edges.
+  double eps_grad_both = 0.8;
   /// --dual: "delaunay", the witnessed triples that are locally Delaunay (restricted_dual.h: one
   /// triangulation per junction); "paper", every witnessed triple (the paper's thick dual).
   std::string dual = "delaunay";
@@ -95,7 +100,8 @@ struct GvdResult {
 ///     cell (2^-21 of the box) with an earlier node is dropped as a duplicate (whole wedges of space project
 ///     onto the same corner point); so is a seed on top of an earlier seed (it gets no faces).
 ///  3. kNN graph (FLANN, exact kd-tree, k = knn) made undirected; an edge is pruned when
-///     d(midpoint) > eps_udf_rel * diagonal or |cos(edge, n)| > eps_grad at either endpoint.
+///     d(midpoint) > eps_udf_rel * diagonal, |cos(edge, n)| > eps_grad at either endpoint or > eps_grad_both
+///     at both.
 ///  4. Multi-source Dijkstra with Euclidean edge lengths labels every node with its geodesically nearest seed;
 ///     unreachable nodes get label -1 and are counted.
 ///  5. For every node labelled i and every two distinct labels j, k (both != i, both >= 0) among its graph

@@ -31,6 +31,8 @@ int main(int argc, char** argv) {
   app.add_option("--knn", options.knn, "neighbours per sample in the kNN graph");
   app.add_option("--eps-udf-rel", options.eps_udf_rel, "prune edges with midpoint UDF above this x diagonal");
   app.add_option("--eps-grad", options.eps_grad, "prune edges with |cos(edge, gradient)| above this at an end");
+  app.add_option("--eps-grad-both", options.eps_grad_both,
+                 "prune edges with |cos(edge, gradient)| above this at both ends (across a thin wall; 1: off)");
   app.add_option("--dual", options.dual,
                  "delaunay: the witnessed triples that are locally Delaunay (one triangulation per junction); "
                  "paper: every witnessed triple (the paper's thick dual)")
