@@ -272,9 +272,12 @@ File Read(const std::string& path) {
   return Parse(bytes, name);
 }
 
-File Parse(const std::string& bytes, const std::string& name) {
+namespace {
+
+// The header: elements and properties declared, encoding, comments. `pos` ends at the body's first byte.
+File ParseHeader(const std::string& bytes, const std::string& name, size_t& pos) {
   File file;
-  size_t pos = 0;
+  pos = 0;
   int line_no = 0;
   bool have_format = false;
   auto next_line = [&](std::string* line) {
@@ -350,8 +353,11 @@ File Parse(const std::string& bytes, const std::string& name) {
   }
   if (!ended) throw InputError(name, "PLY header has no 'end_header' (truncated or not a PLY file)");
   if (!have_format) throw InputError(name, "PLY header has no 'format' line");
+  return file;
+}
 
-  BodyReader body(bytes, pos, name, file.encoding);
+// Refuses a body too short for what the header declares, before anything is allocated from its counts.
+void CheckBodyLength(const File& file, const BodyReader& body, const std::string& name) {
   // Nothing is reserved from a declared count the file cannot hold. An ASCII value takes at least two
   // bytes (a digit and a separator; the last may end the file), so an ASCII body of more values than half
   // its bytes is truncated whatever it says.
@@ -381,6 +387,9 @@ File Parse(const std::string& bytes, const std::string& name) {
                                  " bytes of data, " + std::to_string(body.Remaining()) + " present): truncated file?");
     }
   }
+}
+
+void ReadBody(File& file, BodyReader& body, const std::string& name) {
   for (auto& e : file.elements) {
     // Items of no property take no bytes: nothing to read, however many the header declares (a loop over
     // 10^19 of them would never end).
@@ -406,6 +415,16 @@ File Parse(const std::string& bytes, const std::string& name) {
       }
     }
   }
+}
+
+}  // namespace
+
+File Parse(const std::string& bytes, const std::string& name) {
+  size_t pos = 0;
+  File file = ParseHeader(bytes, name, pos);
+  BodyReader body(bytes, pos, name, file.encoding);
+  CheckBodyLength(file, body, name);
+  ReadBody(file, body, name);
   return file;
 }
 

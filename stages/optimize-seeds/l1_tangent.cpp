@@ -136,12 +136,97 @@ double AscendDual(const L1TangentProblem& p, std::vector<double>& u, std::vector
   return L1TangentDual(p, u, lambda);
 }
 
-L1TangentSolution SolveL1Tangent(const L1TangentProblem& p, const L1TangentOptions& options) {
-  // Primal barrier method on  min Σ w_m t_m + γ‖y‖²  s.t.  −t_m ≤ a_mᵀy − b_m ≤ t_m,  c_kᵀy ≤ h_k.
-  // Newton's system in (y, t) has a diagonal t-block, so eliminating t leaves a 3×3 system: every Newton
-  // step costs O(M + K). The central path's multipliers give a dual point; the gap certifies the result.
+namespace {
+
+double Weight(const L1TangentProblem& p, size_t m) { return p.w.empty() ? 1.0 : p.w[m]; }
+
+// The barrier function τ (Σ w_m t_m + γ‖y‖²) − Σ log s over the slacks s of the L1 problem's constraints;
+// false where a slack is not positive.
+bool BarrierValue(const L1TangentProblem& p, double tau, const Vec3& y, const std::vector<double>& t, double* value) {
+  // Σ log s as the log of running products (flushed long before they could under- or overflow): the
+  // line search evaluates this often, and std::log was 12 % of the stage's time (perf, fandisk 3k).
+  double f = p.gamma * y.squaredNorm(), logs = 0.0, product = 1.0;
+  auto take = [&](double slack) {
+    product *= slack;
+    if (product < 1e-150 || product > 1e150) {
+      logs += std::log(product);
+      product = 1.0;
+    }
+  };
+  for (size_t m = 0; m < p.a.size(); ++m) {
+    const double rm = p.a[m].dot(y) - p.b[m];
+    const double sp = t[m] - rm, sm = t[m] + rm;
+    if (!(sp > 0.0 && sm > 0.0)) return false;
+    f += Weight(p, m) * t[m];
+    take(sp);
+    take(sm);
+  }
+  for (size_t k = 0; k < p.c.size(); ++k) {
+    const double sk = p.h[k] - p.c[k].dot(y);
+    if (!(sk > 0.0)) return false;
+    take(sk);
+  }
+  logs += std::log(product);
+  *value = tau * f - logs;
+  return true;
+}
+
+// One damped Newton step on the barrier at τ from (y, t). Newton's system in (y, t) has a diagonal t-block,
+// so eliminating t leaves a 3×3 system: O(M + K). False when the step is done: the Newton decrement (scale
+// free) is below 1e-10, or rounding leaves no step that decreases the barrier.
+bool NewtonStep(const L1TangentProblem& p, double tau, Vec3& y, std::vector<double>& t) {
   const size_t m_count = p.a.size(), k_count = p.c.size();
-  auto weight = [&](size_t m) { return p.w.empty() ? 1.0 : p.w[m]; };
+  Eigen::Matrix3d h = 2.0 * tau * p.gamma * Eigen::Matrix3d::Identity();
+  Vec3 gy = 2.0 * tau * p.gamma * y;
+  Vec3 rhs = Vec3::Zero();
+  std::vector<double> gt(m_count), e(m_count), d(m_count), dt(m_count);  // gt: the gradient in t
+  for (size_t m = 0; m < m_count; ++m) {
+    const double rm = p.a[m].dot(y) - p.b[m];
+    const double ip = 1.0 / (t[m] - rm), im = 1.0 / (t[m] + rm);
+    gt[m] = tau * Weight(p, m) - ip - im;
+    gy += (ip - im) * p.a[m];
+    d[m] = ip * ip + im * im;
+    e[m] = -ip * ip + im * im;
+    // Schur complement of the t-block: (d − e²/d) a aᵀ = (4 ip² im² / d) a aᵀ.
+    h += (d[m] - e[m] * e[m] / d[m]) * (p.a[m] * p.a[m].transpose());
+    rhs += (e[m] / d[m]) * gt[m] * p.a[m];
+  }
+  for (size_t k = 0; k < k_count; ++k) {
+    const double ik = 1.0 / (p.h[k] - p.c[k].dot(y));
+    gy += ik * p.c[k];
+    h += (ik * ik) * (p.c[k] * p.c[k].transpose());
+  }
+  const Vec3 dy = h.ldlt().solve(-gy + rhs);
+  double decrement = -gy.dot(dy);
+  for (size_t m = 0; m < m_count; ++m) {
+    dt[m] = (-gt[m] - e[m] * p.a[m].dot(dy)) / d[m];
+    decrement -= gt[m] * dt[m];
+  }
+  if (!(decrement > 1e-10)) return false;
+  double f0;
+  BarrierValue(p, tau, y, t, &f0);
+  double step = 1.0;
+  std::vector<double> t_new(m_count);
+  for (int back = 0; back < 60; ++back, step *= 0.5) {
+    const Vec3 y_new = y + step * dy;
+    for (size_t m = 0; m < m_count; ++m) t_new[m] = t[m] + step * dt[m];
+    double f1;
+    if (BarrierValue(p, tau, y_new, t_new, &f1) && f1 <= f0 - 0.25 * step * decrement) {
+      y = y_new;
+      t.swap(t_new);
+      return true;
+    }
+  }
+  return false;
+}
+
+}  // namespace
+
+L1TangentSolution SolveL1Tangent(const L1TangentProblem& p, const L1TangentOptions& options) {
+  // Primal barrier method on  min Σ w_m t_m + γ‖y‖²  s.t.  −t_m ≤ a_mᵀy − b_m ≤ t_m,  c_kᵀy ≤ h_k, by
+  // damped Newton steps (NewtonStep) along the central path. The central path's multipliers give a dual
+  // point; the gap certifies the result.
+  const size_t m_count = p.a.size(), k_count = p.c.size();
   L1TangentSolution best;
   best.primal = L1TangentObjective(p, Vec3::Zero());
   best.dual = 0.0;  // D(0, 0) = 0
@@ -151,94 +236,20 @@ L1TangentSolution SolveL1Tangent(const L1TangentProblem& p, const L1TangentOptio
   }
   const double barrier_terms = static_cast<double>(2 * m_count + k_count);
   Vec3 y = Vec3::Zero();
-  std::vector<double> t(m_count), r(m_count), dt(m_count);
+  std::vector<double> t(m_count);
   for (size_t m = 0; m < m_count; ++m) t[m] = std::abs(p.a[m].dot(y) - p.b[m]) + best.primal / static_cast<double>(m_count) + 1e-12;
   double tau = barrier_terms / best.primal;  // start where the barrier's gap bound equals P(0)
   std::vector<double> u(m_count), lambda(k_count);
 
-  auto barrier = [&](const Vec3& yy, const std::vector<double>& tt, double* value) {
-    // Σ log s as the log of running products (flushed long before they could under- or overflow): the
-    // line search evaluates this often, and std::log was 12 % of the stage's time (perf, fandisk 3k).
-    double f = p.gamma * yy.squaredNorm(), logs = 0.0, product = 1.0;
-    auto take = [&](double slack) {
-      product *= slack;
-      if (product < 1e-150 || product > 1e150) {
-        logs += std::log(product);
-        product = 1.0;
-      }
-    };
-    for (size_t m = 0; m < m_count; ++m) {
-      const double rm = p.a[m].dot(yy) - p.b[m];
-      const double sp = tt[m] - rm, sm = tt[m] + rm;
-      if (!(sp > 0.0 && sm > 0.0)) return false;
-      f += weight(m) * tt[m];
-      take(sp);
-      take(sm);
-    }
-    for (size_t k = 0; k < k_count; ++k) {
-      const double sk = p.h[k] - p.c[k].dot(yy);
-      if (!(sk > 0.0)) return false;
-      take(sk);
-    }
-    logs += std::log(product);
-    *value = tau * f - logs;
-    return true;
-  };
-
   int steps = 0;
   for (int stage = 0; stage < 60 && steps < options.max_newton_steps; ++stage) {
-    // Centre for this τ by damped Newton (the Newton decrement is scale-free: stop below 1e-10, or when
-    // rounding leaves no step that decreases the barrier).
-    for (int stage_steps = 0; steps < options.max_newton_steps && stage_steps < 50; ++steps, ++stage_steps) {
-      Eigen::Matrix3d h = 2.0 * tau * p.gamma * Eigen::Matrix3d::Identity();
-      Vec3 gy = 2.0 * tau * p.gamma * y;
-      Vec3 rhs = Vec3::Zero();
-      std::vector<double>& gt = r;  // reuse: gradient in t
-      std::vector<double> e(m_count), d(m_count);
-      for (size_t m = 0; m < m_count; ++m) {
-        const double rm = p.a[m].dot(y) - p.b[m];
-        const double ip = 1.0 / (t[m] - rm), im = 1.0 / (t[m] + rm);
-        gt[m] = tau * weight(m) - ip - im;
-        gy += (ip - im) * p.a[m];
-        d[m] = ip * ip + im * im;
-        e[m] = -ip * ip + im * im;
-        // Schur complement of the t-block: (d − e²/d) a aᵀ = (4 ip² im² / d) a aᵀ.
-        h += (d[m] - e[m] * e[m] / d[m]) * (p.a[m] * p.a[m].transpose());
-        rhs += (e[m] / d[m]) * gt[m] * p.a[m];
-      }
-      for (size_t k = 0; k < k_count; ++k) {
-        const double ik = 1.0 / (p.h[k] - p.c[k].dot(y));
-        gy += ik * p.c[k];
-        h += (ik * ik) * (p.c[k] * p.c[k].transpose());
-      }
-      const Vec3 dy = h.ldlt().solve(-gy + rhs);
-      double decrement = -gy.dot(dy);
-      for (size_t m = 0; m < m_count; ++m) {
-        dt[m] = (-gt[m] - e[m] * p.a[m].dot(dy)) / d[m];
-        decrement -= gt[m] * dt[m];
-      }
-      if (!(decrement > 1e-10)) break;
-      double f0;
-      barrier(y, t, &f0);
-      double step = 1.0;
-      bool moved = false;
-      std::vector<double> t_new(m_count);
-      for (int back = 0; back < 60 && !moved; ++back, step *= 0.5) {
-        const Vec3 y_new = y + step * dy;
-        for (size_t m = 0; m < m_count; ++m) t_new[m] = t[m] + step * dt[m];
-        double f1;
-        if (barrier(y_new, t_new, &f1) && f1 <= f0 - 0.25 * step * decrement) {
-          y = y_new;
-          t.swap(t_new);
-          moved = true;
-        }
-      }
-      if (!moved) break;
-    }
+    // Centre for this τ.
+    for (int stage_steps = 0; steps < options.max_newton_steps && stage_steps < 50; ++steps, ++stage_steps)
+      if (!NewtonStep(p, tau, y, t)) break;
     // Certificate from the central path's multipliers: u_m = z⁺ − z⁻, λ_k = 1/(τ s_k).
     for (size_t m = 0; m < m_count; ++m) {
       const double rm = p.a[m].dot(y) - p.b[m];
-      u[m] = std::clamp(1.0 / (tau * (t[m] - rm)) - 1.0 / (tau * (t[m] + rm)), -weight(m), weight(m));
+      u[m] = std::clamp(1.0 / (tau * (t[m] - rm)) - 1.0 / (tau * (t[m] + rm)), -Weight(p, m), Weight(p, m));
     }
     for (size_t k = 0; k < k_count; ++k) lambda[k] = 1.0 / (tau * (p.h[k] - p.c[k].dot(y)));
     const double primal = L1TangentObjective(p, y);
