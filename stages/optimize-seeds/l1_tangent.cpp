@@ -20,10 +20,17 @@ void L1TangentProblem::AddTerm(const Vec3& a_m, double b_m, double tolerance) {
   w.push_back(1.0);
 }
 
+namespace {
+
+// w_m, the weight of term m (1 when the problem has no weights).
+double Weight(const L1TangentProblem& p, size_t m) { return p.w.empty() ? 1.0 : p.w[m]; }
+
+}  // namespace
+
 double L1TangentObjective(const L1TangentProblem& problem, const Vec3& y) {
   double sum = 0.0;
   for (size_t m = 0; m < problem.a.size(); ++m)
-    sum += (problem.w.empty() ? 1.0 : problem.w[m]) * std::abs(problem.a[m].dot(y) - problem.b[m]);
+    sum += Weight(problem, m) * std::abs(problem.a[m].dot(y) - problem.b[m]);
   return sum + problem.gamma * y.squaredNorm();
 }
 
@@ -57,7 +64,7 @@ L1TangentSolution SolveL1TangentByCoordinateAscent(const L1TangentProblem& p, co
       const double aa = p.a[m].squaredNorm();
       if (aa == 0.0) continue;
       // dD/du_m = −a_mᵀw/(2γ) − b_m; curvature −‖a_m‖²/(2γ): the exact 1-D maximiser, clipped.
-      const double bound = p.w.empty() ? 1.0 : p.w[m];
+      const double bound = Weight(p, m);
       const double target = std::clamp(u[m] + options.relaxation * (-p.a[m].dot(w) - two_gamma * p.b[m]) / aa, -bound, bound);
       const double step = target - u[m];
       if (step == 0.0) continue;
@@ -122,7 +129,7 @@ double AscendDual(const L1TangentProblem& p, std::vector<double>& u, std::vector
   for (size_t k = 0; k < p.c.size(); ++k) w += lambda[k] * p.c[k];
   for (int sweep = 0; sweep < sweeps; ++sweep) {
     for (size_t m = 0; m < p.a.size(); ++m) {
-      const double bound = p.w.empty() ? 1.0 : p.w[m];
+      const double bound = Weight(p, m);
       const double target = std::clamp(u[m] + (-p.a[m].dot(w) - two_gamma * p.b[m]) / p.a[m].squaredNorm(), -bound, bound);
       w += (target - u[m]) * p.a[m];
       u[m] = target;
@@ -137,8 +144,6 @@ double AscendDual(const L1TangentProblem& p, std::vector<double>& u, std::vector
 }
 
 namespace {
-
-double Weight(const L1TangentProblem& p, size_t m) { return p.w.empty() ? 1.0 : p.w[m]; }
 
 // The barrier function τ (Σ w_m t_m + γ‖y‖²) − Σ log s over the slacks s of the L1 problem's constraints;
 // false where a slack is not positive.
