@@ -569,10 +569,20 @@ class Optimizer {
           if (rank == 2 && std::abs(t_new.dot(e)) < 0.8 * e.norm()) continue;
           crowd_radius = 0.5 * spacing;
         }
-        // Not beside a feature seed, nor beside a trial seed kept in this round (two ends facing each other).
-        index.WithinRadius(landed[t], crowd_radius, near);
+        // Not beside a feature seed, nor beside a trial seed kept in this round (two ends facing each other):
+        // never nearer than the clearance, so that the feature-seed thinning keeps every seed added here.
+        // Nor a curve seed within a spacing of a corner: a cell that near sees the corner's planes, so the seed
+        // would be ranked 3 at the next analysis and stepped onto the corner, crowding it, and the thinning may
+        // then keep the one beside the corner (open corners of crossing-planes and three-discs: a
+        // non-manifold edge 0.004–0.01 off the curve).
+        crowd_radius = std::max(crowd_radius, clearance);
+        index.WithinRadius(landed[t], std::max(crowd_radius, spacing), near);
         bool crowded = false;
-        for (int j : near) crowded = crowded || s.rank[static_cast<size_t>(j)].rank >= 2;
+        for (int j : near) {
+          const int rank_j = s.rank[static_cast<size_t>(j)].rank;
+          const double d = (s.position[static_cast<size_t>(j)] - landed[t]).norm();
+          crowded = crowded || (rank_j >= 2 && d < crowd_radius) || (rank_j == 3 && rank == 2);
+        }
         for (size_t k = n; k < s.position.size() && !crowded; ++k)
           crowded = (s.position[k] - landed[t]).norm() < crowd_radius;
         if (crowded) continue;
@@ -971,34 +981,44 @@ SeedCloud OptimizeSeeds(const Udf& udf, const SeedCloud& input, const OptimizeSe
   // every seed, see docs). More than one: a seed whose cell sees the second sheet only after the first step
   // (rank 1 -> 2) gets onto the curve in the next (crossing-planes and sphere-disc, 25 runs: seeds left
   // 0.003–0.007 off the curve with one step, none with three).
-  size_t crowded = 0;
-  for (int step = 0; step < (options.max_outer_iters > 0 ? options.feature_steps : 0); ++step) {
-    const CellSamples cells = opt.Analyze(s);
-    std::vector<double> misfit;
-    std::vector<Vec3> targets = opt.L1Step(s, cells, true, &misfit);
-    // Seeds whose steps meet are thinned before the move (the better fitting target stays): otherwise two
-    // corner seeds both step onto one corner, Project undoes both moves as too near, and neither reaches it.
-    if (options.feature_clearance > 0.0) {
-      crowded += ThinCrowded(s, targets, misfit, options.feature_clearance * opt.MeanSpacing(s.position), &targets);
+  // Step 7 as a function of the state: run again after step 8 (below).
+  auto settle_features = [&]() {
+    size_t crowded = 0;
+    for (int step = 0; step < (options.max_outer_iters > 0 ? options.feature_steps : 0); ++step) {
+      const CellSamples cells = opt.Analyze(s);
+      std::vector<double> misfit;
+      std::vector<Vec3> targets = opt.L1Step(s, cells, true, &misfit);
+      // Seeds whose steps meet are thinned before the move (the better fitting target stays): otherwise two
+      // corner seeds both step onto one corner, Project undoes both moves as too near, and neither reaches it.
+      if (options.feature_clearance > 0.0) {
+        crowded += ThinCrowded(s, targets, misfit, options.feature_clearance * opt.MeanSpacing(s.position), &targets);
+      }
+      const std::vector<Vec3> before = s.position;
+      opt.Project(s, before, std::move(targets), 0.25 * opt.MeanSpacing(s.position));
     }
-    const std::vector<Vec3> before = s.position;
-    opt.Project(s, before, std::move(targets), 0.25 * opt.MeanSpacing(s.position));
-  }
+    // The ranks at the final positions; then the seeds crowding a higher-ranked feature seed there.
+    const CellSamples final_cells = opt.Analyze(s);
+    if (options.feature_clearance > 0.0) crowded += opt.DropCrowded(s, final_cells);
+    return crowded;
+  };
+  size_t crowded = settle_features();
   const auto [spacing_out, cv_out] = opt.SpacingStats(s.position);
-  // The ranks at the final positions; then the seeds crowding a higher-ranked feature seed there.
-  const CellSamples final_cells = opt.Analyze(s);
-  if (options.feature_clearance > 0.0) crowded += opt.DropCrowded(s, final_cells);
   if (crowded > 0)
     monitor.Info(std::to_string(crowded) + Format(" seeds dropped by the feature-seed thinning (nearer than %.2f x the "
                                                   "mean spacing to a kept curve or corner seed)", options.feature_clearance));
-  // The chains filled once more at the final positions, so that the invariant holds for the output.
+  // The chains filled once more at the final positions, so that the invariant holds for the output. The
+  // added seeds change their neighbours' cells: a sheet seed beside a crossing may see the second sheet
+  // only now (rank 1 -> 2), so step 7 runs again and every seed ranked as a feature ends on its feature.
   if (chains) {
     const ChainFill fill = fill_chains(kFeatureChainRounds, false);
-    if (fill.added > 0)
+    if (fill.added > 0) {
+      const size_t settled = settle_features();
       monitor.Info(std::to_string(fill.added) + " seeds added on feature chains (" +
                    (options.feature_gap_max > 0.0 ? (options.feature_chord_tol > 0.0 ? "gaps, ends, bends" : "gaps, ends")
                                                   : "bends") +
-                   "); " + std::to_string(fill.dropped) + " sheet seeds beside them dropped");
+                   "); " + std::to_string(fill.dropped) + " sheet seeds beside them dropped, " +
+                   std::to_string(settled) + " by the feature-seed thinning after the last feature steps");
+    }
   }
   if (const SamplePool* pool = opt.pool())
     monitor.Info("sample pool: " + std::to_string(pool->points()) + " points in " + std::to_string(pool->buckets()) +
