@@ -9,6 +9,7 @@
 
 #include "common/errors.h"
 #include "common/projection.h"
+#include "stages/optimize-seeds/feature_seeds.h"
 #include "stages/optimize-seeds/l1_tangent.h"
 #include "stages/optimize-seeds/repulsion.h"
 #include "stages/optimize-seeds/seed_index.h"
@@ -67,169 +68,6 @@ std::string Format(const char* format, double a = 0, double b = 0, double c = 0,
   return line;
 }
 
-// The state carried through Alg. 1: positions on the zero set with their field, ranks and move spaces.
-struct State {
-  std::vector<Vec3> position;
-  std::vector<double> udf;
-  std::vector<Vec3> normal;
-  std::vector<TangentRank> rank;
-  std::vector<MoveSpace> space;
-};
-
-// The direction a curve seed may move in (rank 2: its move space is a line); zero for the others.
-std::vector<Vec3> Tangents(const State& s) {
-  std::vector<Vec3> tangent(s.position.size(), Vec3::Zero());
-  for (size_t i = 0; i < tangent.size(); ++i)
-    if (s.rank[i].rank == 2 && s.space[i].dim == 1) tangent[i] = s.space[i].basis.col(0);
-  return tangent;
-}
-
-// The mean distance of x from the tangent planes of seed i's cell samples, |n·(p − x) − d| (the terms of
-// the L1 energy, paper Eq. energy_l1); +inf for a cell without one. Decides between crowded feature seeds.
-double TangentMisfit(const CellSamples& cells, size_t i, const Vec3& x) {
-  double sum = 0.0;
-  size_t count = 0;
-  for (size_t m = cells.sample_offset[i]; m < cells.sample_offset[i + 1]; ++m) {
-    const Vec3& g = cells.gradient[m];
-    if (g.squaredNorm() < 0.25) continue;  // as in L1Step: no tangent plane
-    sum += std::abs(g.normalized().dot(cells.point[m] - x) - cells.distance[m]);
-    ++count;
-  }
-  return count > 0 ? sum / static_cast<double>(count) : INFINITY;
-}
-
-// The links of the feature curves: every curve seed (rank 2, with a tangent) and the nearest feature seed
-// ahead of it and behind it along its tangent (and along the other's, when it has one), within `radius`.
-// chords: each such pair once, sorted. ends: a curve seed with no such seed on one side (the chain ends
-// there, or has a gap longer than the radius), with the unit direction of that side.
-struct FeatureLinks {
-  std::vector<std::pair<int, int>> chords;
-  std::vector<std::pair<int, Vec3>> ends;
-};
-
-FeatureLinks FindFeatureLinks(const State& s, const std::vector<Vec3>& tangent, double radius) {
-  const size_t n = s.position.size();
-  FeatureLinks links;
-  const SeedIndex index(s.position);
-  std::vector<int> found;
-  for (size_t i = 0; i < n; ++i) {
-    if (s.rank[i].rank != 2 || tangent[i].isZero()) continue;
-    index.WithinRadius(s.position[i], radius, found);
-    int best[2] = {-1, -1};
-    for (int j : found) {  // nearest first
-      const size_t uj = static_cast<size_t>(j);
-      if (uj == i || s.rank[uj].rank < 2) continue;
-      const Vec3 e = s.position[uj] - s.position[i];
-      const double along = e.dot(tangent[i]);
-      if (std::abs(along) < 0.8 * e.norm()) continue;
-      if (!tangent[uj].isZero() && std::abs(e.dot(tangent[uj])) < 0.8 * e.norm()) continue;
-      int& side = best[along > 0.0 ? 0 : 1];
-      if (side < 0) side = j;
-    }
-    for (int k = 0; k < 2; ++k) {
-      const int j = best[k];
-      if (j >= 0) {
-        links.chords.emplace_back(std::min<int>(static_cast<int>(i), j), std::max<int>(static_cast<int>(i), j));
-      } else {
-        links.ends.emplace_back(static_cast<int>(i), k == 0 ? tangent[i] : Vec3(-tangent[i]));
-      }
-    }
-  }
-  std::sort(links.chords.begin(), links.chords.end());
-  links.chords.erase(std::unique(links.chords.begin(), links.chords.end()), links.chords.end());
-  return links;
-}
-
-// Removes the seeds marked in `drop` from every array of the state, keeping the others' order.
-void EraseSeeds(State& s, const std::vector<char>& drop) {
-  size_t k = 0;
-  for (size_t i = 0; i < s.position.size(); ++i) {
-    if (drop[i]) continue;
-    s.position[k] = s.position[i];
-    s.udf[k] = s.udf[i];
-    s.normal[k] = s.normal[i];
-    s.rank[k] = s.rank[i];
-    s.space[k] = s.space[i];
-    ++k;
-  }
-  s.position.resize(k);
-  s.udf.resize(k);
-  s.normal.resize(k);
-  s.rank.resize(k);
-  s.space.resize(k);
-}
-
-// Drops the seeds below index `first` that are not on a feature (rank < 2) and lie within `clearance` of a
-// seed from `first` on (seeds just added onto a feature curve), as the feature-seed thinning keeps sheet
-// seeds clear of curve seeds.
-void DropSheetSeedsNear(State& s, size_t first, double clearance) {
-  const SeedIndex index(s.position);
-  std::vector<char> drop(s.position.size(), 0);
-  std::vector<int> near;
-  for (size_t i = first; i < s.position.size(); ++i) {
-    index.WithinRadius(s.position[i], clearance, near);
-    for (int j : near)
-      if (static_cast<size_t>(j) < first && s.rank[static_cast<size_t>(j)].rank < 2) drop[static_cast<size_t>(j)] = 1;
-  }
-  EraseSeeds(s, drop);
-}
-
-// Keeps the seed count after seeds were added on the feature chains: drops up to `count` sheet seeds (rank
-// 1) whose 6 nearest seeds are sheet seeds too, the most crowded first (smallest nearest-neighbour
-// distance, then index), never two that are among each other's 6 nearest, so that no hole wider than
-// about a spacing opens and no feature's neighbourhood thins. Returns the count dropped.
-size_t DropCrowdedSheetSeeds(State& s, size_t count) {
-  constexpr int kNeighbours = 6;
-  const size_t n = s.position.size();
-  const SeedIndex index(s.position);
-  std::vector<std::vector<int>> near(n);
-  std::vector<double> nearest(n, INFINITY);
-  std::vector<size_t> candidates;
-  for (size_t i = 0; i < n; ++i) {
-    if (s.rank[i].rank != 1) continue;
-    index.Nearest(s.position[i], kNeighbours + 1, near[i]);
-    bool sheet = near[i].size() > 1;
-    for (int j : near[i]) sheet = sheet && s.rank[static_cast<size_t>(j)].rank == 1;
-    if (!sheet) continue;
-    for (int j : near[i])
-      if (static_cast<size_t>(j) != i) nearest[i] = std::min(nearest[i], (s.position[static_cast<size_t>(j)] - s.position[i]).norm());
-    candidates.push_back(i);
-  }
-  std::sort(candidates.begin(), candidates.end(),
-            [&](size_t a, size_t b) { return nearest[a] != nearest[b] ? nearest[a] < nearest[b] : a < b; });
-  std::vector<char> drop(n, 0), blocked(n, 0);
-  size_t dropped = 0;
-  for (size_t i : candidates) {
-    if (dropped == count) break;
-    if (blocked[i]) continue;
-    drop[i] = 1;
-    ++dropped;
-    for (int j : near[i]) blocked[static_cast<size_t>(j)] = 1;
-  }
-  EraseSeeds(s, drop);
-  return dropped;
-}
-
-// Feature-seed thinning (SeedsBesideFeatures) judged at `where` (the seeds' positions or their step
-// targets), at the state's ranks; the marked seeds leave the state and, if given, `carried` (a per-seed
-// array alongside it). `where` may be s.position or *carried: it is read before either changes. Returns the
-// count dropped.
-size_t ThinCrowded(State& s, const std::vector<Vec3>& where, const std::vector<double>& misfit, double limit,
-                   std::vector<Vec3>* carried = nullptr) {
-  std::vector<uint8_t> ranks(s.rank.size());
-  for (size_t i = 0; i < ranks.size(); ++i) ranks[i] = static_cast<uint8_t>(s.rank[i].rank);
-  const std::vector<char> drop = SeedsBesideFeatures(where, ranks, limit, misfit, Tangents(s));
-  const size_t dropped = static_cast<size_t>(std::count(drop.begin(), drop.end(), 1));
-  if (dropped == 0) return 0;
-  EraseSeeds(s, drop);
-  if (carried) {
-    size_t k = 0;
-    for (size_t i = 0; i < drop.size(); ++i)
-      if (!drop[i]) (*carried)[k++] = (*carried)[i];
-    carried->resize(k);
-  }
-  return dropped;
-}
 
 // Rounds of RefineFeatureChains: each halves the chords it refines, so their misfit falls by 4 per round,
 // and takes a chain's end one spacing farther along its feature.
@@ -257,7 +95,7 @@ class Optimizer {
   // (everything beyond a cube corner lands on the corner; L1 steps of neighbours meet on a feature at their
   // common cell face), and seeds that meet would make σ, the minimum pairwise distance, shrink for every
   // seed, iteration after iteration. Returns the largest displacement from `previous`.
-  double Project(State& s, const std::vector<Vec3>& previous, std::vector<Vec3> moved, double min_separation) {
+  double Project(SeedState& s, const std::vector<Vec3>& previous, std::vector<Vec3> moved, double min_separation) {
     const size_t n = moved.size();
     ProjectionResult r = ProjectToZeroSet(udf_, moved, projection_, Monitor::Null());
     std::vector<char> accept(r.converged);
@@ -321,7 +159,7 @@ class Optimizer {
   // Cells, samples, rank and null space of every seed at the current positions. early: the repulsion
   // rounds, which only need ranks and null spaces, let cells that clearly see one plane stop at
   // --early-samples; the L1 steps and the final ranks take every cell whole.
-  CellSamples Analyze(State& s, bool early = false) {
+  CellSamples Analyze(SeedState& s, bool early = false) {
     const SeedIndex index(s.position);
     CellSamplingOptions cell_options = cell_options_;
     if (!early) cell_options.early_samples = 0;
@@ -387,7 +225,7 @@ class Optimizer {
   // Between repulsion rounds without new cells (--repulsion-cells first): ranks stay, a seed that moves in a
   // plane (a sheet seed) takes the tangent plane of its own gradient where Project left it, which is the
   // surface's there; a curve seed keeps its line, a corner stays fixed.
-  void FollowTangentPlanes(State& s) const {
+  void FollowTangentPlanes(SeedState& s) const {
     for (size_t i = 0; i < s.position.size(); ++i) {
       if (s.space[i].dim != 2 || s.normal[i].squaredNorm() < 0.25) continue;
       const MoveSpace own = OwnTangentPlane(s.normal[i]);
@@ -410,7 +248,7 @@ class Optimizer {
   // misfit_at_target (optional): per seed, TangentMisfit at its new position, from the solver's terms (+inf
   // for a seed that did not move).
   // movers (optional): only the seeds marked there move.
-  std::vector<Vec3> L1Step(const State& s, const CellSamples& cells, bool features_only = false,
+  std::vector<Vec3> L1Step(const SeedState& s, const CellSamples& cells, bool features_only = false,
                            std::vector<double>* misfit_at_target = nullptr, const std::vector<char>* movers = nullptr) {
     const long n = static_cast<long>(s.position.size());
     if (misfit_at_target) misfit_at_target->assign(static_cast<size_t>(n), INFINITY);
@@ -495,7 +333,7 @@ class Optimizer {
   // clearances is at most `max_gap` long and has its midpoint within `bend_tol` of its curve, and one
   // spacing beyond every chain end there is no further curve for the L1 step to find. Sheet seeds nearer
   // than `clearance` to an added seed are dropped, as the feature-seed thinning does. Returns the count added.
-  size_t RefineFeatureChains(State& s, double bend_tol, double max_gap, double clearance, int rounds) {
+  size_t RefineFeatureChains(SeedState& s, double bend_tol, double max_gap, double clearance, int rounds) {
     const size_t n0 = s.position.size();
     size_t added = 0, last_added = 0;
     const double spacing = MeanSpacing(s.position);
@@ -527,7 +365,7 @@ class Optimizer {
       std::vector<Vec3> trial_points(trials.size());
       for (size_t k = 0; k < trials.size(); ++k) trial_points[k] = trials[k].start;
       const ProjectionResult projected = ProjectToZeroSet(udf_, trial_points, projection_, Monitor::Null());
-      State trial = s;
+      SeedState trial = s;
       std::vector<size_t> trial_of;
       for (size_t k = 0; k < trials.size(); ++k) {
         if (!projected.converged[k]) continue;
@@ -609,7 +447,7 @@ class Optimizer {
   // sigma_min_spacing × that distance: on CAD shapes the minimum is a crowded pair at a sharp edge, far below
   // the spacing, and a kernel that narrow leaves the sheets uneven (fandisk 2.5k: spacing CV 0.29, mean
   // triangle quality 0.64; with the floor 0.18 and 0.80).
-  double KernelWidth(const State& s) const {
+  double KernelWidth(const SeedState& s) const {
     const SeedIndex index(s.position);
     const long n = static_cast<long>(s.position.size());
     std::vector<double> nearest(static_cast<size_t>(n), INFINITY);
@@ -636,7 +474,7 @@ class Optimizer {
   // Thins the seeds at their current positions and ranks (feature_clearance × the mean spacing). A seed's
   // misfit, which decides between two crowded feature seeds, is the mean distance of its position from the
   // tangent planes of its cell's samples: zero on the corner itself. Returns the count dropped.
-  size_t DropCrowded(State& s, const CellSamples& cells) const {
+  size_t DropCrowded(SeedState& s, const CellSamples& cells) const {
     std::vector<double> misfit(s.position.size());
     for (size_t i = 0; i < misfit.size(); ++i) misfit[i] = TangentMisfit(cells, i, s.position[i]);
     return ThinCrowded(s, s.position, misfit, options_.feature_clearance * MeanSpacing(s.position));
@@ -719,7 +557,7 @@ class Optimizer {
   double normal_spread_ = 0.0;  ///< the last Analyze's UnexplainedNormalSpread (0 with --rank-noise off)
 };
 
-SeedCloud ToCloud(const State& s) {
+SeedCloud ToCloud(const SeedState& s) {
   SeedCloud cloud;
   cloud.Resize(s.position.size());
   for (size_t i = 0; i < s.position.size(); ++i) {
@@ -731,7 +569,7 @@ SeedCloud ToCloud(const State& s) {
   return cloud;
 }
 
-void CountRanks(const State& s, OuterIterationReport& report) {
+void CountRanks(const SeedState& s, OuterIterationReport& report) {
   double sum = 0.0;
   for (size_t i = 0; i < s.position.size(); ++i) {
     ++report.rank_count[std::clamp(s.rank[i].rank, 0, 3)];
@@ -741,7 +579,7 @@ void CountRanks(const State& s, OuterIterationReport& report) {
 }
 
 // Input seeds on the zero set, in input order, without exact duplicates (their repulsion has no direction).
-State Prepare(const Udf& udf, const SeedCloud& input, const ProjectionOptions& projection, Monitor& monitor) {
+SeedState Prepare(const Udf& udf, const SeedCloud& input, const ProjectionOptions& projection, Monitor& monitor) {
   if (input.size() < 2)
     throw InputError("input seeds", "has " + std::to_string(input.size()) + " seed(s); optimize-seeds needs at least 2");
   std::vector<size_t> order(input.size());
@@ -762,7 +600,7 @@ State Prepare(const Udf& udf, const SeedCloud& input, const ProjectionOptions& p
   if (points.size() < 2) throw InputError("input seeds", "fewer than 2 distinct seeds");
 
   ProjectionResult r = ProjectToZeroSet(udf, points, projection, monitor);
-  State s;
+  SeedState s;
   for (size_t i = 0; i < points.size(); ++i) {
     if (!r.converged[i]) continue;
     s.position.push_back(points[i]);
@@ -779,80 +617,13 @@ State Prepare(const Udf& udf, const SeedCloud& input, const ProjectionOptions& p
 
 }  // namespace
 
-std::vector<char> SeedsBesideFeatures(const std::vector<Vec3>& position, const std::vector<uint8_t>& rank, double limit,
-                                      const std::vector<double>& misfit, const std::vector<Vec3>& tangent) {
-  if (!misfit.empty() && misfit.size() != position.size()) throw std::invalid_argument("SeedsBesideFeatures: misfit size");
-  if (!tangent.empty() && tangent.size() != position.size()) throw std::invalid_argument("SeedsBesideFeatures: tangent size");
-  const size_t n = position.size();
-  std::vector<char> drop(n, 0);
-  std::vector<Vec3> feature;
-  std::vector<size_t> feature_id;
-  for (size_t i = 0; i < n; ++i)
-    if (rank[i] >= 2) {
-      feature.push_back(position[i]);
-      feature_id.push_back(i);
-    }
-  if (feature.empty()) return drop;
-  // Greedy thinning: corners first, then curve seeds, then the sheets; within a rank by misfit (or input
-  // order). A seed is dropped when a feature seed kept before it lies within the limit: so a sheet seed gives
-  // way to a curve or corner seed, a curve seed to a corner or another curve seed, a corner to a corner.
-  auto clamped = [&](size_t i) { return std::min<int>(rank[i], 3); };
-  std::vector<size_t> order(n);
-  std::iota(order.begin(), order.end(), size_t{0});
-  std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) {
-    if (clamped(a) != clamped(b)) return clamped(a) > clamped(b);
-    return !misfit.empty() && misfit[a] < misfit[b];
-  });
-  const SeedIndex index(feature);
-  std::vector<char> kept(n, 0);
-  std::vector<int> found;
-  // A sheet seed between two curve seeds is also near the curve: the segment between two kept feature
-  // seeds stands for the curve when it runs along the curve tangent of its ends (of those that have one,
-  // at least one). The tangent test keeps a segment from cutting across a face between two edges' seeds.
-  auto along_curve = [&](size_t a, size_t b) {
-    const Vec3 e = (position[b] - position[a]).normalized();
-    int with_tangent = 0;
-    for (size_t end : {a, b}) {
-      if (tangent[end].squaredNorm() == 0.0) continue;
-      if (std::abs(tangent[end].dot(e)) < 0.9) return false;
-      ++with_tangent;
-    }
-    return with_tangent > 0;
-  };
-  auto segment_distance = [&](const Vec3& p, const Vec3& a, const Vec3& b) {
-    const Vec3 ab = b - a;
-    const double t = std::clamp((p - a).dot(ab) / ab.squaredNorm(), 0.0, 1.0);
-    return (p - (a + t * ab)).norm();
-  };
-  std::vector<size_t> near;
-  for (size_t i : order) {
-    index.WithinRadius(position[i], limit, found);
-    for (int f : found) {
-      const size_t j = feature_id[static_cast<size_t>(f)];
-      if (kept[j]) drop[i] = 1;
-    }
-    if (!drop[i] && clamped(i) < 2 && !tangent.empty()) {
-      index.WithinRadius(position[i], 3.0 * limit, found);
-      near.clear();
-      for (int f : found)
-        if (kept[feature_id[static_cast<size_t>(f)]]) near.push_back(feature_id[static_cast<size_t>(f)]);
-      for (size_t a = 0; a < near.size() && !drop[i]; ++a)
-        for (size_t b = a + 1; b < near.size() && !drop[i]; ++b)
-          if (along_curve(near[a], near[b]) && segment_distance(position[i], position[near[a]], position[near[b]]) < limit)
-            drop[i] = 1;
-    }
-    kept[i] = !drop[i];
-  }
-  return drop;
-}
-
 SeedCloud OptimizeSeeds(const Udf& udf, const SeedCloud& input, const OptimizeSeedsOptions& options, Monitor& monitor,
                         const std::function<void(const OuterIterationReport&, const SeedCloud&)>& on_iteration) {
   options.Check();
   using Clock = std::chrono::steady_clock;
   const auto start = Clock::now();
   Optimizer opt(udf, options, monitor);
-  State s = Prepare(udf, input, opt.projection(), monitor);
+  SeedState s = Prepare(udf, input, opt.projection(), monitor);
   const size_t n = s.position.size();
   const auto [spacing_in, cv_in] = opt.SpacingStats(s.position);
   // Buckets of 1.5 spacings: a cell's ball (radius ~0.8 spacing) meets 8-27, whose points are scanned in one

@@ -1,0 +1,211 @@
+#include "stages/optimize-seeds/feature_seeds.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <stdexcept>
+
+#include "stages/optimize-seeds/optimize_seeds.h"
+#include "stages/optimize-seeds/seed_index.h"
+
+namespace voroudf {
+
+std::vector<Vec3> Tangents(const SeedState& s) {
+  std::vector<Vec3> tangent(s.position.size(), Vec3::Zero());
+  for (size_t i = 0; i < tangent.size(); ++i)
+    if (s.rank[i].rank == 2 && s.space[i].dim == 1) tangent[i] = s.space[i].basis.col(0);
+  return tangent;
+}
+
+double TangentMisfit(const CellSamples& cells, size_t i, const Vec3& x) {
+  double sum = 0.0;
+  size_t count = 0;
+  for (size_t m = cells.sample_offset[i]; m < cells.sample_offset[i + 1]; ++m) {
+    const Vec3& g = cells.gradient[m];
+    if (g.squaredNorm() < 0.25) continue;  // as in L1Step: no tangent plane
+    sum += std::abs(g.normalized().dot(cells.point[m] - x) - cells.distance[m]);
+    ++count;
+  }
+  return count > 0 ? sum / static_cast<double>(count) : INFINITY;
+}
+
+FeatureLinks FindFeatureLinks(const SeedState& s, const std::vector<Vec3>& tangent, double radius) {
+  const size_t n = s.position.size();
+  FeatureLinks links;
+  const SeedIndex index(s.position);
+  std::vector<int> found;
+  for (size_t i = 0; i < n; ++i) {
+    if (s.rank[i].rank != 2 || tangent[i].isZero()) continue;
+    index.WithinRadius(s.position[i], radius, found);
+    int best[2] = {-1, -1};
+    for (int j : found) {  // nearest first
+      const size_t uj = static_cast<size_t>(j);
+      if (uj == i || s.rank[uj].rank < 2) continue;
+      const Vec3 e = s.position[uj] - s.position[i];
+      const double along = e.dot(tangent[i]);
+      if (std::abs(along) < 0.8 * e.norm()) continue;
+      if (!tangent[uj].isZero() && std::abs(e.dot(tangent[uj])) < 0.8 * e.norm()) continue;
+      int& side = best[along > 0.0 ? 0 : 1];
+      if (side < 0) side = j;
+    }
+    for (int k = 0; k < 2; ++k) {
+      const int j = best[k];
+      if (j >= 0) {
+        links.chords.emplace_back(std::min<int>(static_cast<int>(i), j), std::max<int>(static_cast<int>(i), j));
+      } else {
+        links.ends.emplace_back(static_cast<int>(i), k == 0 ? tangent[i] : Vec3(-tangent[i]));
+      }
+    }
+  }
+  std::sort(links.chords.begin(), links.chords.end());
+  links.chords.erase(std::unique(links.chords.begin(), links.chords.end()), links.chords.end());
+  return links;
+}
+
+void EraseSeeds(SeedState& s, const std::vector<char>& drop) {
+  size_t k = 0;
+  for (size_t i = 0; i < s.position.size(); ++i) {
+    if (drop[i]) continue;
+    s.position[k] = s.position[i];
+    s.udf[k] = s.udf[i];
+    s.normal[k] = s.normal[i];
+    s.rank[k] = s.rank[i];
+    s.space[k] = s.space[i];
+    ++k;
+  }
+  s.position.resize(k);
+  s.udf.resize(k);
+  s.normal.resize(k);
+  s.rank.resize(k);
+  s.space.resize(k);
+}
+
+void DropSheetSeedsNear(SeedState& s, size_t first, double clearance) {
+  const SeedIndex index(s.position);
+  std::vector<char> drop(s.position.size(), 0);
+  std::vector<int> near;
+  for (size_t i = first; i < s.position.size(); ++i) {
+    index.WithinRadius(s.position[i], clearance, near);
+    for (int j : near)
+      if (static_cast<size_t>(j) < first && s.rank[static_cast<size_t>(j)].rank < 2) drop[static_cast<size_t>(j)] = 1;
+  }
+  EraseSeeds(s, drop);
+}
+
+size_t DropCrowdedSheetSeeds(SeedState& s, size_t count) {
+  constexpr int kNeighbours = 6;
+  const size_t n = s.position.size();
+  const SeedIndex index(s.position);
+  std::vector<std::vector<int>> near(n);
+  std::vector<double> nearest(n, INFINITY);
+  std::vector<size_t> candidates;
+  for (size_t i = 0; i < n; ++i) {
+    if (s.rank[i].rank != 1) continue;
+    index.Nearest(s.position[i], kNeighbours + 1, near[i]);
+    bool sheet = near[i].size() > 1;
+    for (int j : near[i]) sheet = sheet && s.rank[static_cast<size_t>(j)].rank == 1;
+    if (!sheet) continue;
+    for (int j : near[i])
+      if (static_cast<size_t>(j) != i) nearest[i] = std::min(nearest[i], (s.position[static_cast<size_t>(j)] - s.position[i]).norm());
+    candidates.push_back(i);
+  }
+  std::sort(candidates.begin(), candidates.end(),
+            [&](size_t a, size_t b) { return nearest[a] != nearest[b] ? nearest[a] < nearest[b] : a < b; });
+  std::vector<char> drop(n, 0), blocked(n, 0);
+  size_t dropped = 0;
+  for (size_t i : candidates) {
+    if (dropped == count) break;
+    if (blocked[i]) continue;
+    drop[i] = 1;
+    ++dropped;
+    for (int j : near[i]) blocked[static_cast<size_t>(j)] = 1;
+  }
+  EraseSeeds(s, drop);
+  return dropped;
+}
+
+size_t ThinCrowded(SeedState& s, const std::vector<Vec3>& where, const std::vector<double>& misfit, double limit,
+                   std::vector<Vec3>* carried) {
+  std::vector<uint8_t> ranks(s.rank.size());
+  for (size_t i = 0; i < ranks.size(); ++i) ranks[i] = static_cast<uint8_t>(s.rank[i].rank);
+  const std::vector<char> drop = SeedsBesideFeatures(where, ranks, limit, misfit, Tangents(s));
+  const size_t dropped = static_cast<size_t>(std::count(drop.begin(), drop.end(), 1));
+  if (dropped == 0) return 0;
+  EraseSeeds(s, drop);
+  if (carried) {
+    size_t k = 0;
+    for (size_t i = 0; i < drop.size(); ++i)
+      if (!drop[i]) (*carried)[k++] = (*carried)[i];
+    carried->resize(k);
+  }
+  return dropped;
+}
+
+std::vector<char> SeedsBesideFeatures(const std::vector<Vec3>& position, const std::vector<uint8_t>& rank, double limit,
+                                      const std::vector<double>& misfit, const std::vector<Vec3>& tangent) {
+  if (!misfit.empty() && misfit.size() != position.size()) throw std::invalid_argument("SeedsBesideFeatures: misfit size");
+  if (!tangent.empty() && tangent.size() != position.size()) throw std::invalid_argument("SeedsBesideFeatures: tangent size");
+  const size_t n = position.size();
+  std::vector<char> drop(n, 0);
+  std::vector<Vec3> feature;
+  std::vector<size_t> feature_id;
+  for (size_t i = 0; i < n; ++i)
+    if (rank[i] >= 2) {
+      feature.push_back(position[i]);
+      feature_id.push_back(i);
+    }
+  if (feature.empty()) return drop;
+  // Greedy thinning: corners first, then curve seeds, then the sheets; within a rank by misfit (or input
+  // order). A seed is dropped when a feature seed kept before it lies within the limit: so a sheet seed gives
+  // way to a curve or corner seed, a curve seed to a corner or another curve seed, a corner to a corner.
+  auto clamped = [&](size_t i) { return std::min<int>(rank[i], 3); };
+  std::vector<size_t> order(n);
+  std::iota(order.begin(), order.end(), size_t{0});
+  std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) {
+    if (clamped(a) != clamped(b)) return clamped(a) > clamped(b);
+    return !misfit.empty() && misfit[a] < misfit[b];
+  });
+  const SeedIndex index(feature);
+  std::vector<char> kept(n, 0);
+  std::vector<int> found;
+  // A sheet seed between two curve seeds is also near the curve: the segment between two kept feature
+  // seeds stands for the curve when it runs along the curve tangent of its ends (of those that have one,
+  // at least one). The tangent test keeps a segment from cutting across a face between two edges' seeds.
+  auto along_curve = [&](size_t a, size_t b) {
+    const Vec3 e = (position[b] - position[a]).normalized();
+    int with_tangent = 0;
+    for (size_t end : {a, b}) {
+      if (tangent[end].squaredNorm() == 0.0) continue;
+      if (std::abs(tangent[end].dot(e)) < 0.9) return false;
+      ++with_tangent;
+    }
+    return with_tangent > 0;
+  };
+  auto segment_distance = [&](const Vec3& p, const Vec3& a, const Vec3& b) {
+    const Vec3 ab = b - a;
+    const double t = std::clamp((p - a).dot(ab) / ab.squaredNorm(), 0.0, 1.0);
+    return (p - (a + t * ab)).norm();
+  };
+  std::vector<size_t> near;
+  for (size_t i : order) {
+    index.WithinRadius(position[i], limit, found);
+    for (int f : found) {
+      const size_t j = feature_id[static_cast<size_t>(f)];
+      if (kept[j]) drop[i] = 1;
+    }
+    if (!drop[i] && clamped(i) < 2 && !tangent.empty()) {
+      index.WithinRadius(position[i], 3.0 * limit, found);
+      near.clear();
+      for (int f : found)
+        if (kept[feature_id[static_cast<size_t>(f)]]) near.push_back(feature_id[static_cast<size_t>(f)]);
+      for (size_t a = 0; a < near.size() && !drop[i]; ++a)
+        for (size_t b = a + 1; b < near.size() && !drop[i]; ++b)
+          if (along_curve(near[a], near[b]) && segment_distance(position[i], position[near[a]], position[near[b]]) < limit)
+            drop[i] = 1;
+    }
+    kept[i] = !drop[i];
+  }
+  return drop;
+}
+
+}  // namespace voroudf

@@ -1,0 +1,66 @@
+#pragma once
+// The optimizer's per-seed state and the operations on feature seeds that step 7 (feature-seed thinning)
+// and step 8 (feature chains) of docs/optimize-seeds.md make: which seeds crowd a feature seed, the links
+// of the feature curves, and dropping seeds from the state. Used by optimize_seeds.cpp; tests reach
+// SeedsBesideFeatures through optimize_seeds.h.
+
+#include <cstddef>
+#include <utility>
+#include <vector>
+
+#include "common/types.h"
+#include "stages/optimize-seeds/l1_tangent.h"
+#include "stages/optimize-seeds/repulsion.h"
+#include "stages/optimize-seeds/voronoi_cells.h"
+
+namespace voroudf {
+
+/// The state carried through Alg. 1: positions on the zero set with their field, ranks and move spaces.
+struct SeedState {
+  std::vector<Vec3> position;
+  std::vector<double> udf;
+  std::vector<Vec3> normal;
+  std::vector<TangentRank> rank;
+  std::vector<MoveSpace> space;
+};
+
+/// The direction a curve seed may move in (rank 2: its move space is a line); zero for the others.
+std::vector<Vec3> Tangents(const SeedState& s);
+
+/// The mean distance of x from the tangent planes of seed i's cell samples, |n·(p − x) − d| (the terms of
+/// the L1 energy, paper Eq. energy_l1); +inf for a cell without one. Decides between crowded feature seeds.
+double TangentMisfit(const CellSamples& cells, size_t i, const Vec3& x);
+
+/// The links of the feature curves: every curve seed (rank 2, with a tangent) and the nearest feature seed
+/// ahead of it and behind it along its tangent (and along the other's, when it has one), within `radius`.
+/// chords: each such pair once, sorted. ends: a curve seed with no such seed on one side (the chain ends
+/// there, or has a gap longer than the radius), with the unit direction of that side.
+struct FeatureLinks {
+  std::vector<std::pair<int, int>> chords;
+  std::vector<std::pair<int, Vec3>> ends;
+};
+
+FeatureLinks FindFeatureLinks(const SeedState& s, const std::vector<Vec3>& tangent, double radius);
+
+/// Removes the seeds marked in `drop` from every array of the state, keeping the others' order.
+void EraseSeeds(SeedState& s, const std::vector<char>& drop);
+
+/// Drops the seeds below index `first` that are not on a feature (rank < 2) and lie within `clearance` of a
+/// seed from `first` on (seeds just added onto a feature curve), as the feature-seed thinning keeps sheet
+/// seeds clear of curve seeds.
+void DropSheetSeedsNear(SeedState& s, size_t first, double clearance);
+
+/// Keeps the seed count after seeds were added on the feature chains: drops up to `count` sheet seeds (rank
+/// 1) whose 6 nearest seeds are sheet seeds too, the most crowded first (smallest nearest-neighbour
+/// distance, then index), never two that are among each other's 6 nearest, so that no hole wider than
+/// about a spacing opens and no feature's neighbourhood thins. Returns the count dropped.
+size_t DropCrowdedSheetSeeds(SeedState& s, size_t count);
+
+/// Feature-seed thinning (SeedsBesideFeatures) judged at `where` (the seeds' positions or their step
+/// targets), at the state's ranks; the marked seeds leave the state and, if given, `carried` (a per-seed
+/// array alongside it). `where` may be s.position or *carried: it is read before either changes. Returns the
+/// count dropped.
+size_t ThinCrowded(SeedState& s, const std::vector<Vec3>& where, const std::vector<double>& misfit, double limit,
+                   std::vector<Vec3>* carried = nullptr);
+
+}  // namespace voroudf
