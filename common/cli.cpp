@@ -12,6 +12,7 @@
 #include "common/atomic_file.h"
 #include "common/cleanup.h"
 #include "common/errors.h"
+#include "common/huge_pages.h"
 #include "common/shapes.h"
 
 namespace voroudf {
@@ -199,8 +200,10 @@ int StageCli::Run(int argc, char** argv, const std::function<void()>& check,
                  program_.c_str());
     return kExitUsage;
   }
+  const bool huge_pages = StartWithHugePages(argv);  // may start the program again, with the same arguments
   InstallCleanupHandlers();
   StderrMonitor monitor(program_, quiet_ ? LogLevel::kError : verbose_ ? LogLevel::kDebug : LogLevel::kInfo);
+  if (huge_pages) monitor.Debug("heap in transparent huge pages (started again with glibc.malloc.hugetlb=1)");
   try {
     CheckBeforeWork();
     if (threads_ > 0) omp_set_num_threads(threads_);

@@ -378,5 +378,42 @@ TEST(Executables, ANewlineInTheUdfPathKeepsEveryHeaderWhole) {
   EXPECT_NE(ReadBytes(dir / "s.ply").find("two\\x0alines.obj\n"), std::string::npos);
 }
 
+// ---- the second start with huge pages (common/huge_pages.h) ----
+
+bool KernelAsksForMadvise() {
+  std::ifstream in("/sys/kernel/mm/transparent_hugepage/enabled");
+  std::string line;
+  return std::getline(in, line) && line.find("[madvise]") != std::string::npos;
+}
+
+// An exec: source that writes its environment's GLIBC_TUNABLES and VOROUDF_SAVED_GLIBC_TUNABLES lines to
+// `file`, then fails the handshake (sample-seeds then exits 3, which is not what is tested).
+int RunWithEnvProbe(const std::string& env, const std::string& file) {
+  const std::string probe = "env | grep -E \\\"^(GLIBC_TUNABLES|VOROUDF_SAVED_GLIBC_TUNABLES)=\\\" > " + file;
+  return Bash(env + " \"$B/sample-seeds\" --udf \"exec:" + probe + "; exit 1\" -o " + file + ".ply -q 2>/dev/null");
+}
+
+TEST(HugePages, ChildProcessesSeeTheCallersEnvironment) {
+  TempDir dir;
+  EXPECT_EQ(RunWithEnvProbe("GLIBC_TUNABLES=glibc.malloc.check=0", dir / "set.txt"), kExitBadInput);
+  EXPECT_EQ(ReadBytes(dir / "set.txt"), "GLIBC_TUNABLES=glibc.malloc.check=0\n");
+  EXPECT_EQ(RunWithEnvProbe("env -u GLIBC_TUNABLES", dir / "unset.txt"), kExitBadInput);
+  EXPECT_EQ(ReadBytes(dir / "unset.txt"), "");
+}
+
+TEST(HugePages, TheStageStartsAgainWithTheTunableAndWritesTheSameBytes) {
+  if (!KernelAsksForMadvise()) GTEST_SKIP() << "transparent huge pages are not 'madvise' here: nothing to start again";
+  TempDir dir;
+  const std::string log = dir / "log.txt";
+  ASSERT_EQ(Bash("\"$B/sample-seeds\" --udf shape:torus --count 300 -o " + dir / "seeds.ply -q && "
+                 "env -u GLIBC_TUNABLES \"$B/build-gvd\" --udf shape:torus -i " + dir / "seeds.ply -o " +
+                 dir / "on.ply -v 2> " + log +
+                 " && VOROUDF_HUGE_PAGES=0 \"$B/build-gvd\" --udf shape:torus -i " + dir / "seeds.ply -o " +
+                 dir / "off.ply -v 2> " + dir / "off.txt"), 0);
+  EXPECT_NE(ReadBytes(log).find("heap in transparent huge pages"), std::string::npos);
+  EXPECT_EQ(ReadBytes(dir / "off.txt").find("heap in transparent huge pages"), std::string::npos);
+  EXPECT_EQ(ReadBytes(dir / "on.ply"), ReadBytes(dir / "off.ply"));
+}
+
 }  // namespace
 }  // namespace voroudf
