@@ -9,8 +9,7 @@ PACKAGES=(
   build-essential cmake              # compiler, make, cmake
   libeigen3-dev libcli11-dev libgtest-dev
   libceres-dev                       # L-BFGS (optimize-seeds)
-  libpcl-dev                         # neighbour search (optimize-seeds)
-  libflann-dev                       # kNN graphs (build-gvd)
+  libflann-dev                       # kd-trees: kNN graphs (build-gvd), seed neighbours (optimize-seeds)
   libopenmesh-dev libcgal-dev        # manifold mesh work, exact predicates
   python3-numpy snakemake            # exec: reference server, Python package, Snakefile
   python3-vtk9 xvfb xauth            # pictures (pipelines/render.py: VTK under a virtual X server)

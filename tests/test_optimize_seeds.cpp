@@ -1027,5 +1027,44 @@ TEST_F(OptimizeSeedsExe, HelpExplainsTheOptions) {
     EXPECT_NE(r.out.find(flag), std::string::npos) << flag;
 }
 
+// The seed kd-tree against brute force in float coordinates (what the tree holds): the k nearest, nearest
+// first, the query's own point included; every point within a radius, nearest first; k clamped to the size.
+TEST(SeedIndex, AnswersAsBruteForceInFloat) {
+  Rng rng(7, 0);
+  std::vector<Vec3> points(2000);
+  for (Vec3& p : points) p = Vec3(rng.Uniform(), rng.Uniform(), rng.Uniform());
+  const SeedIndex index(points);
+  auto squared = [&](const Vec3& q, size_t i) {
+    float sum = 0.0f;
+    for (int a = 0; a < 3; ++a) {
+      const float d = static_cast<float>(points[i][a]) - static_cast<float>(q[a]);
+      sum += d * d;
+    }
+    return sum;
+  };
+  std::vector<int> found;
+  for (int trial = 0; trial < 200; ++trial) {
+    const Vec3 q = trial % 2 ? points[static_cast<size_t>(trial)] : Vec3(rng.Uniform(), rng.Uniform(), rng.Uniform());
+    std::vector<std::pair<float, int>> all;
+    for (size_t i = 0; i < points.size(); ++i) all.emplace_back(squared(q, i), static_cast<int>(i));
+    std::sort(all.begin(), all.end());
+    index.Nearest(q, 12, found);
+    ASSERT_EQ(found.size(), 12u);
+    for (size_t j = 0; j < found.size(); ++j) EXPECT_EQ(squared(q, static_cast<size_t>(found[j])), all[j].first);
+    if (trial % 2) {
+      EXPECT_EQ(found[0], trial);
+    }
+    const double radius = 0.08;
+    index.WithinRadius(q, radius, found);
+    const float radius_sq = static_cast<float>(radius * radius);
+    const auto inside = static_cast<size_t>(
+        std::count_if(all.begin(), all.end(), [&](const auto& e) { return e.first < radius_sq; }));
+    ASSERT_EQ(found.size(), inside);
+    for (size_t j = 0; j < found.size(); ++j) EXPECT_EQ(squared(q, static_cast<size_t>(found[j])), all[j].first);
+  }
+  index.Nearest(points[0], 5000, found);
+  EXPECT_EQ(found.size(), points.size());
+}
+
 }  // namespace
 }  // namespace voroudf

@@ -1,6 +1,6 @@
 #pragma once
-// Nearest-neighbour queries over the seeds. PCL (KdTreeFLANN) does the work; its headers compile slowly, so
-// they stay in seed_index.cpp behind this small interface.
+// Nearest-neighbour queries over the seeds: the kd-tree PCL's KdTreeFLANN builds, queried one point at a
+// time through FLANN (seed_index.cpp says why not through PCL). FLANN's headers stay in seed_index.cpp.
 #include <memory>
 #include <vector>
 
@@ -9,8 +9,8 @@
 namespace voroudf {
 
 /// A kd-tree over a fixed set of points. Queries are const and thread-safe (each call uses its own
-/// result buffers), so they can run inside OpenMP loops. PCL stores float coordinates: distances it
-/// reports are float-accurate; callers that need exact comparisons recompute them in double.
+/// result buffers), so they can run inside OpenMP loops. The tree holds float coordinates: its distances
+/// are float-accurate; callers that need exact comparisons recompute them in double.
 class SeedIndex {
  public:
   /// \pre points is not empty; the index keeps no reference to `points`.
@@ -20,7 +20,7 @@ class SeedIndex {
   SeedIndex& operator=(const SeedIndex&) = delete;
 
   /// The k nearest points to `query` (the query's own point included if it is indexed), nearest first;
-  /// ties keep PCL's deterministic order. Returns fewer than k when the index is smaller.
+  /// ties keep FLANN's deterministic order (PCL's). Returns fewer than k when the index is smaller.
   void Nearest(const Vec3& query, int k, std::vector<int>& indices) const;
 
   /// All points within `radius` of `query`, sorted by distance (nearest first).
