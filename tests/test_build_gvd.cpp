@@ -74,6 +74,57 @@ TEST(BuildGvd, LabelsAreTheGeodesicallyNearestSeedOnTheSphere) {
   EXPECT_LT(worst_ratio, 1.4);  // zigzag of a sparse (6k samples) kNN graph
 }
 
+// The sweep is an exact multi-source shortest-path labelling of its own graph: every node's distance equals,
+// to the bit, the fixed point Bellman-Ford reaches over the written graph with the same arithmetic, and its
+// label is that of the predecessor on its shortest path (where that predecessor is unique).
+TEST(BuildGvd, TheSweepIsExactShortestPathsOverItsGraph) {
+  const auto udf = MakeShape("torus");
+  const SeedCloud seeds = Seeds(*udf, 80);
+  const GvdResult r = BuildGvd(*udf, seeds, BuildGvdOptions{}, true, Monitor::Null());
+  const LabeledSamples& g = r.samples;
+  const size_t n = g.size();
+  ASSERT_GT(g.edges.size(), n);
+  std::vector<double> d(n, INFINITY);
+  std::vector<int> label(n, -1);
+  size_t sources = 0;
+  for (size_t i = 0; i < n; ++i)
+    if (g.dist[i] == 0.0) {
+      d[i] = 0.0;
+      label[i] = g.label[i];
+      ++sources;
+    }
+  ASSERT_EQ(sources, seeds.size());
+  auto length = [&](size_t from, size_t to) { return (g.position[to] - g.position[from]).norm(); };
+  for (bool changed = true; changed;) {
+    changed = false;
+    for (const auto& e : g.edges)
+      for (int side = 0; side < 2; ++side) {
+        const size_t u = static_cast<size_t>(e[side]), v = static_cast<size_t>(e[1 - side]);
+        const double dv = d[u] + length(u, v);
+        if (dv < d[v]) {
+          d[v] = dv;
+          label[v] = label[u];
+          changed = true;
+        }
+      }
+  }
+  std::vector<std::set<int>> best_labels(n);
+  for (const auto& e : g.edges)
+    for (int side = 0; side < 2; ++side) {
+      const size_t u = static_cast<size_t>(e[side]), v = static_cast<size_t>(e[1 - side]);
+      if (d[u] + length(u, v) == d[v]) best_labels[v].insert(label[u]);
+    }
+  size_t judged = 0;
+  for (size_t i = 0; i < n; ++i) {
+    ASSERT_EQ(g.dist[i], std::isfinite(d[i]) ? d[i] : -1.0) << "node " << i;
+    if (best_labels[i].size() == 1) {
+      EXPECT_EQ(g.label[i], *best_labels[i].begin()) << "node " << i;
+      ++judged;
+    }
+  }
+  EXPECT_GT(judged, n / 2);
+}
+
 TEST(BuildGvd, SeedsLabelThemselvesAndEveryDualTriangleIsDistinct) {
   const auto udf = MakeShape("sphere");
   const SeedCloud seeds = Seeds(*udf, 200);

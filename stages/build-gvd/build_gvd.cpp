@@ -7,6 +7,8 @@
 #include <algorithm>
 #include <array>
 #include <cstdarg>
+#include <cstdint>
+#include <cstring>
 #include <limits>
 #include <cmath>
 #include <cstdio>
@@ -14,7 +16,6 @@
 #include <iterator>
 #include <unordered_map>
 #include <numeric>
-#include <queue>
 #include <utility>
 
 #include "common/errors.h"
@@ -401,30 +402,76 @@ Graph PrunedGraph(const Udf& udf, const std::vector<Vec3>& node, const std::vect
   return Graph{std::move(edges), std::move(keep), std::move(offset), std::move(adj)};
 }
 
+// A radix heap (Ahuja, Mehlhorn, Orlin, Tarjan 1990) over the bits of non-negative doubles, whose order as
+// unsigned integers is their order as numbers. Dijkstra pops keys in non-decreasing order, which is all a
+// radix heap needs; each item moves down at most 64 buckets, so a pop costs O(1) amortised instead of a
+// binary heap's O(log n) cache-missing sift (a third of the geodesic sweep on fandisk). Hand-written: no
+// installed library (Boost.Heap, the STL) has a monotone integer-key heap.
+class RadixHeap {
+ public:
+  bool empty() const { return size_ == 0; }
+  /// \pre key >= the last popped key, key finite and >= 0
+  void push(double key, int item) {
+    const uint64_t bits = Bits(key);
+    bucket_[Bucket(bits)].emplace_back(bits, item);
+    ++size_;
+  }
+  /// The item of least key (any of those with that key) and its key. \pre !empty()
+  std::pair<double, int> pop() {
+    if (bucket_[0].empty()) {
+      size_t b = 1;
+      while (bucket_[b].empty()) ++b;
+      uint64_t least = bucket_[b][0].first;
+      for (const auto& e : bucket_[b]) least = std::min(least, e.first);
+      last_ = least;
+      for (const auto& e : bucket_[b]) bucket_[Bucket(e.first)].push_back(e);
+      bucket_[b].clear();
+    }
+    const auto [bits, item] = bucket_[0].back();
+    bucket_[0].pop_back();
+    --size_;
+    double key;
+    std::memcpy(&key, &bits, sizeof key);
+    return {key, item};
+  }
+
+ private:
+  static uint64_t Bits(double key) {
+    uint64_t bits;
+    std::memcpy(&bits, &key, sizeof bits);
+    return bits;
+  }
+  // Bucket 0: keys equal to the last popped one; bucket b: keys whose highest bit differing from it is b - 1.
+  size_t Bucket(uint64_t bits) const {
+    return bits == last_ ? 0 : 64 - static_cast<size_t>(__builtin_clzll(bits ^ last_));
+  }
+  std::array<std::vector<std::pair<uint64_t, int>>, 65> bucket_;
+  uint64_t last_ = 0;
+  size_t size_ = 0;
+};
+
 // Step 4: multi-source Dijkstra over the graph from the seed nodes, Euclidean edge lengths: every node's
 // geodesically nearest seed (label, -1 if unreached) and its distance.
 void GeodesicSweep(const Graph& g, const std::vector<Vec3>& node, const std::vector<int>& node_seed,
                    std::vector<double>* dist_out, std::vector<int>* label_out, Monitor& monitor) {
   const size_t n = node.size();
-  // Hand-written (a binary heap over (distance, node) pairs): no installed library
-  // runs a multi-source sweep that also records the source. Sequential, hence deterministic.
+  // Hand-written (over RadixHeap): no installed library runs a multi-source sweep that also records the
+  // source. Sequential, hence deterministic.
   std::vector<double>& dist = *dist_out;
   std::vector<int>& label = *label_out;
   dist.assign(n, INFINITY);
   label.assign(n, -1);
-  using Item = std::pair<double, int>;
-  std::priority_queue<Item, std::vector<Item>, std::greater<Item>> heap;
+  RadixHeap heap;
   for (size_t i = 0; i < n; ++i)
     if (node_seed[i] >= 0) {
       dist[i] = 0.0;
       label[i] = node_seed[i];
-      heap.emplace(0.0, static_cast<int>(i));
+      heap.push(0.0, static_cast<int>(i));
     }
   {
     Task task(monitor, "geodesic sweep", n);
     while (!heap.empty()) {
-      const auto [du, u] = heap.top();
-      heap.pop();
+      const auto [du, u] = heap.pop();
       const size_t su = static_cast<size_t>(u);
       if (du > dist[su]) continue;
       task.Advance(1);
@@ -434,7 +481,7 @@ void GeodesicSweep(const Graph& g, const std::vector<Vec3>& node, const std::vec
         if (dv < dist[v]) {
           dist[v] = dv;
           label[v] = label[su];
-          heap.emplace(dv, static_cast<int>(v));
+          heap.push(dv, static_cast<int>(v));
         }
       }
     }
