@@ -8,7 +8,6 @@
 #include <array>
 #include <cstdarg>
 #include <cstdint>
-#include <cstring>
 #include <limits>
 #include <cmath>
 #include <cstdio>
@@ -24,10 +23,13 @@
 #include "common/morton.h"
 #include "common/projection.h"
 #include "common/rng.h"
+#include "stages/build-gvd/geodesic_sweep.h"
 #include "stages/build-gvd/restricted_dual.h"
 
 namespace voroudf {
 namespace {
+
+constexpr size_t kSweepRangeNodes = 32768;
 
 std::string Format(const char* fmt, ...) __attribute__((format(printf, 1, 2)));
 std::string Format(const char* fmt, ...) {
@@ -402,92 +404,6 @@ Graph PrunedGraph(const Udf& udf, const std::vector<Vec3>& node, const std::vect
   return Graph{std::move(edges), std::move(keep), std::move(offset), std::move(adj)};
 }
 
-// A radix heap (Ahuja, Mehlhorn, Orlin, Tarjan 1990) over the bits of non-negative doubles, whose order as
-// unsigned integers is their order as numbers. Dijkstra pops keys in non-decreasing order, which is all a
-// radix heap needs; each item moves down at most 64 buckets, so a pop costs O(1) amortised instead of a
-// binary heap's O(log n) cache-missing sift (a third of the geodesic sweep on fandisk). Hand-written: no
-// installed library (Boost.Heap, the STL) has a monotone integer-key heap.
-class RadixHeap {
- public:
-  bool empty() const { return size_ == 0; }
-  /// \pre key >= the last popped key, key finite and >= 0
-  void push(double key, int item) {
-    const uint64_t bits = Bits(key);
-    bucket_[Bucket(bits)].emplace_back(bits, item);
-    ++size_;
-  }
-  /// The item of least key (any of those with that key) and its key. \pre !empty()
-  std::pair<double, int> pop() {
-    if (bucket_[0].empty()) {
-      size_t b = 1;
-      while (bucket_[b].empty()) ++b;
-      uint64_t least = bucket_[b][0].first;
-      for (const auto& e : bucket_[b]) least = std::min(least, e.first);
-      last_ = least;
-      for (const auto& e : bucket_[b]) bucket_[Bucket(e.first)].push_back(e);
-      bucket_[b].clear();
-    }
-    const auto [bits, item] = bucket_[0].back();
-    bucket_[0].pop_back();
-    --size_;
-    double key;
-    std::memcpy(&key, &bits, sizeof key);
-    return {key, item};
-  }
-
- private:
-  static uint64_t Bits(double key) {
-    uint64_t bits;
-    std::memcpy(&bits, &key, sizeof bits);
-    return bits;
-  }
-  // Bucket 0: keys equal to the last popped one; bucket b: keys whose highest bit differing from it is b - 1.
-  size_t Bucket(uint64_t bits) const {
-    return bits == last_ ? 0 : 64 - static_cast<size_t>(__builtin_clzll(bits ^ last_));
-  }
-  std::array<std::vector<std::pair<uint64_t, int>>, 65> bucket_;
-  uint64_t last_ = 0;
-  size_t size_ = 0;
-};
-
-// Step 4: multi-source Dijkstra over the graph from the seed nodes, Euclidean edge lengths: every node's
-// geodesically nearest seed (label, -1 if unreached) and its distance.
-void GeodesicSweep(const Graph& g, const std::vector<Vec3>& node, const std::vector<int>& node_seed,
-                   std::vector<double>* dist_out, std::vector<int>* label_out, Monitor& monitor) {
-  const size_t n = node.size();
-  // Hand-written (over RadixHeap): no installed library runs a multi-source sweep that also records the
-  // source. Sequential, hence deterministic.
-  std::vector<double>& dist = *dist_out;
-  std::vector<int>& label = *label_out;
-  dist.assign(n, INFINITY);
-  label.assign(n, -1);
-  RadixHeap heap;
-  for (size_t i = 0; i < n; ++i)
-    if (node_seed[i] >= 0) {
-      dist[i] = 0.0;
-      label[i] = node_seed[i];
-      heap.push(0.0, static_cast<int>(i));
-    }
-  {
-    Task task(monitor, "geodesic sweep", n);
-    while (!heap.empty()) {
-      const auto [du, u] = heap.pop();
-      const size_t su = static_cast<size_t>(u);
-      if (du > dist[su]) continue;
-      task.Advance(1);
-      for (size_t a = g.offset[su]; a < g.offset[su + 1]; ++a) {
-        const size_t v = static_cast<size_t>(g.adj[a]);
-        const double dv = du + (node[v] - node[su]).norm();
-        if (dv < dist[v]) {
-          dist[v] = dv;
-          label[v] = label[su];
-          heap.push(dv, static_cast<int>(v));
-        }
-      }
-    }
-  }
-}
-
 // Step 5: the witnessed triples, every (i, j, k) with a node of label i and graph neighbours of labels j
 // and k (all distinct, all >= 0), sorted, each once.
 std::vector<Tri> WitnessedTriples(const Graph& g, const std::vector<int>& label) {
@@ -588,7 +504,11 @@ GvdResult BuildGvd(const Udf& udf, const SeedCloud& seeds, const BuildGvdOptions
   const Graph graph = PrunedGraph(udf, node, node_d, node_n, options, diag, with_graph, stats, monitor);
   std::vector<double> dist;
   std::vector<int> label;
-  GeodesicSweep(graph, node, node_seed, &dist, &label, monitor);
+  // Ranges of about 32 k nodes: each range's values (1.2 MB) stay in a core's cache while it is swept, and
+  // the ranges run in parallel; fandisk's sweep went from 0.5 s to 0.14 s on two threads (0.22 s on one).
+  // A function of the graph alone, so the result does not depend on the thread count.
+  const size_t parts = std::max<size_t>(1, n / kSweepRangeNodes);
+  GeodesicSweep(graph.offset, graph.adj, node, node_seed, parts, &dist, &label, monitor);
   monitor.Debug("geodesic sweep done");
   for (size_t i = 0; i < n; ++i) stats.unreached += label[i] < 0 ? 1 : 0;
   if (stats.unreached > 0)
