@@ -357,8 +357,9 @@ TEST_F(ChainTest, SphereWithInnerDiscKeepsItsEquator) {
 // Issue #17's thin part: shape:sphere-ring is a sphere inside a ring whose tube (radius 0.03) is about one
 // spacing of 700 uniform seeds around (docs/sample-seeds.md, "Thin parts"). The whole chain with
 // sample-seeds --thin-boost 4 must close the tube (the mesh: two closed components, the sphere and a torus,
-// chi 2 + 0, no boundary or non-manifold edge) in most of eight --seed values, and clearly more often than
-// with uniform seeds (measured: 5 of 8 against 1 of 8).
+// chi 2 + 0, no boundary or non-manifold edge) in most of four --seed values, and clearly more often than
+// with uniform seeds (measured: 4 of 4 against 1 of 4; over --seed 0-7, 5 of 8 against 1 of 8). Four, not
+// eight: the sixteen chains took 9 minutes under AddressSanitizer.
 TEST_F(ChainTest, ThinBoostClosesTheSphereRingsTube) {
   if (!HaveOptimizer()) GTEST_SKIP() << "optimize-seeds is not built";
   const std::string udf = "shape:sphere-ring";
@@ -381,14 +382,14 @@ TEST_F(ChainTest, ThinBoostClosesTheSphereRingsTube) {
     return t.components == 2 && t.euler == 2 && t.boundary_edges == 0 && t.nonmanifold_edges == 0;
   };
   int uniform = 0, boosted = 0;
-  for (int seed = 0; seed < 8; ++seed) {
+  for (int seed = 0; seed < 4; ++seed) {
     uniform += closed("1", seed);
     boosted += closed("4", seed);
   }
-  std::printf("sphere-ring, 700 seeds: tube closed in %d of 8 runs with uniform seeds, %d with --thin-boost 4\n",
+  std::printf("sphere-ring, 700 seeds: tube closed in %d of 4 runs with uniform seeds, %d with --thin-boost 4\n",
               uniform, boosted);
-  EXPECT_GE(boosted, 4);
-  EXPECT_GE(boosted, uniform + 3);
+  EXPECT_GE(boosted, 3);
+  EXPECT_GE(boosted, uniform + 2);
 }
 
 }  // namespace
