@@ -76,47 +76,6 @@ TEST(BuildGvd, LabelsAreTheGeodesicallyNearestSeedOnTheSphere) {
   EXPECT_LT(worst_ratio, 1.4);  // zigzag of a sparse (6k samples) kNN graph
 }
 
-// The sweep is an exact multi-source shortest-path labelling of its own graph: every node's distance equals,
-// to the bit, the fixed point Bellman-Ford reaches over the written graph with the same arithmetic, and so
-// does its label (the lower seed index where two are equally near).
-TEST(BuildGvd, TheSweepIsExactShortestPathsOverItsGraph) {
-  const auto udf = MakeShape("torus");
-  const SeedCloud seeds = Seeds(*udf, 80);
-  const GvdResult r = BuildGvd(*udf, seeds, BuildGvdOptions{}, true, Monitor::Null());
-  const LabeledSamples& g = r.samples;
-  const size_t n = g.size();
-  ASSERT_GT(g.edges.size(), n);
-  std::vector<double> d(n, INFINITY);
-  std::vector<int> label(n, -1);
-  size_t sources = 0;
-  for (size_t i = 0; i < n; ++i)
-    if (g.dist[i] == 0.0) {
-      d[i] = 0.0;
-      label[i] = g.label[i];
-      ++sources;
-    }
-  ASSERT_EQ(sources, seeds.size());
-  // Bellman-Ford to its fixed point, in the sweep's order of (distance, label): the least over all paths.
-  auto length = [&](size_t from, size_t to) { return (g.position[to] - g.position[from]).norm(); };
-  for (bool changed = true; changed;) {
-    changed = false;
-    for (const auto& e : g.edges)
-      for (int side = 0; side < 2; ++side) {
-        const size_t u = static_cast<size_t>(e[side]), v = static_cast<size_t>(e[1 - side]);
-        const double dv = d[u] + length(u, v);
-        if (dv < d[v] || (dv == d[v] && label[u] < label[v])) {
-          d[v] = dv;
-          label[v] = label[u];
-          changed = true;
-        }
-      }
-  }
-  for (size_t i = 0; i < n; ++i) {
-    ASSERT_EQ(g.dist[i], std::isfinite(d[i]) ? d[i] : -1.0) << "node " << i;
-    ASSERT_EQ(g.label[i], label[i]) << "node " << i;
-  }
-}
-
 // A graph in CSR form from an edge list (both directions).
 struct CsrGraph {
   std::vector<size_t> offset;
@@ -135,6 +94,64 @@ CsrGraph Csr(size_t n, const std::vector<std::pair<int, int>>& edges) {
     g.offset.push_back(g.adj.size());
   }
   return g;
+}
+
+// Bellman-Ford to its fixed point, in the sweep's order of (distance, label): the least over all paths from
+// the nodes with node_seed >= 0, with the sweep's arithmetic (a path's length summed in path order).
+void LeastPathsByBellmanFord(const CsrGraph& g, const std::vector<Vec3>& node, const std::vector<int>& node_seed,
+                             std::vector<double>* d_out, std::vector<int>* label_out) {
+  const size_t n = node.size();
+  std::vector<double>& d = *d_out;
+  std::vector<int>& label = *label_out;
+  d.assign(n, INFINITY);
+  label.assign(n, -1);
+  for (size_t i = 0; i < n; ++i)
+    if (node_seed[i] >= 0) {
+      d[i] = 0.0;
+      label[i] = node_seed[i];
+    }
+  for (bool changed = true; changed;) {
+    changed = false;
+    for (size_t u = 0; u < n; ++u)
+      for (size_t a = g.offset[u]; a < g.offset[u + 1]; ++a) {
+        const size_t v = static_cast<size_t>(g.adj[a]);
+        const double dv = d[u] + (node[v] - node[u]).norm();
+        if (dv < d[v] || (dv == d[v] && label[u] < label[v])) {
+          d[v] = dv;
+          label[v] = label[u];
+          changed = true;
+        }
+      }
+  }
+}
+
+// The sweep is an exact multi-source shortest-path labelling of its own graph: every node's distance equals,
+// to the bit, the fixed point Bellman-Ford reaches over the written graph with the same arithmetic, and so
+// does its label (the lower seed index where two are equally near).
+TEST(BuildGvd, TheSweepIsExactShortestPathsOverItsGraph) {
+  const auto udf = MakeShape("torus");
+  const SeedCloud seeds = Seeds(*udf, 80);
+  const GvdResult r = BuildGvd(*udf, seeds, BuildGvdOptions{}, true, Monitor::Null());
+  const LabeledSamples& g = r.samples;
+  const size_t n = g.size();
+  ASSERT_GT(g.edges.size(), n);
+  std::vector<int> node_seed(n, -1);
+  size_t sources = 0;
+  for (size_t i = 0; i < n; ++i)
+    if (g.dist[i] == 0.0) {
+      node_seed[i] = g.label[i];
+      ++sources;
+    }
+  ASSERT_EQ(sources, seeds.size());
+  std::vector<std::pair<int, int>> edges;
+  for (const auto& e : g.edges) edges.emplace_back(e[0], e[1]);
+  std::vector<double> d;
+  std::vector<int> label;
+  LeastPathsByBellmanFord(Csr(n, edges), g.position, node_seed, &d, &label);
+  for (size_t i = 0; i < n; ++i) {
+    ASSERT_EQ(g.dist[i], std::isfinite(d[i]) ? d[i] : -1.0) << "node " << i;
+    ASSERT_EQ(g.label[i], label[i]) << "node " << i;
+  }
 }
 
 // The sweep over ranges swept apart and joined gives the sequential sweep's answer for any number of
@@ -197,26 +214,9 @@ TEST(GeodesicSweep, RangesJoinedGiveTheBellmanFordFixedPoint) {
   const CsrGraph g = Csr(n, edges);
   std::vector<int> node_seed(n, -1);
   for (int s = 0; s < 40; ++s) node_seed[static_cast<size_t>(rng.Below(n))] = s;
-  std::vector<double> d(n, INFINITY);
-  std::vector<int> label(n, -1);
-  for (size_t i = 0; i < n; ++i)
-    if (node_seed[i] >= 0) {
-      d[i] = 0.0;
-      label[i] = node_seed[i];
-    }
-  for (bool changed = true; changed;) {
-    changed = false;
-    for (size_t u = 0; u < n; ++u)
-      for (size_t a = g.offset[u]; a < g.offset[u + 1]; ++a) {
-        const size_t v = static_cast<size_t>(g.adj[a]);
-        const double dv = d[u] + (node[v] - node[u]).norm();
-        if (dv < d[v] || (dv == d[v] && label[u] < label[v])) {
-          d[v] = dv;
-          label[v] = label[u];
-          changed = true;
-        }
-      }
-  }
+  std::vector<double> d;
+  std::vector<int> label;
+  LeastPathsByBellmanFord(g, node, node_seed, &d, &label);
   for (size_t parts : {size_t{1}, size_t{2}, size_t{5}, size_t{100}}) {
     std::vector<double> dist;
     std::vector<int> got;

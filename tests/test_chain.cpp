@@ -353,7 +353,6 @@ TEST_F(ChainTest, SphereWithInnerDiscKeepsItsEquator) {
   ExpectOnSurface(c, "sphere-disc");
 }
 
-
 // Issue #17's thin part: shape:sphere-ring is a sphere inside a ring whose tube (radius 0.03) is about one
 // spacing of 700 uniform seeds around (docs/sample-seeds.md, "Thin parts"). The whole chain with
 // sample-seeds --thin-boost 4 must close the tube (the mesh: two closed components, the sphere and a torus,

@@ -101,12 +101,16 @@ void GeodesicSweep(const std::vector<size_t>& offset, const std::vector<int>& ad
   dist.assign(n, INFINITY);
   label.assign(n, -1);
   parts = std::clamp<size_t>(parts, 1, std::max<size_t>(n, 1));
+  auto range = [&](long lp) {
+    const size_t p = static_cast<size_t>(lp);
+    return std::pair<size_t, size_t>(n * p / parts, n * (p + 1) / parts);
+  };
   Task task(monitor, "geodesic sweep", n);
   // Hand-written (over RadixHeap): no installed library runs a multi-source sweep that also records the
   // source. Each range's sweep touches only its own nodes' values, so the ranges run in parallel.
 #pragma omp parallel for schedule(dynamic, 1)
   for (long lp = 0; lp < static_cast<long>(parts); ++lp) {
-    const size_t p = static_cast<size_t>(lp), lo = n * p / parts, hi = n * (p + 1) / parts;
+    const auto [lo, hi] = range(lp);
     RadixHeap heap;
     for (size_t i = lo; i < hi; ++i)
       if (node_seed[i] >= 0) {
@@ -125,7 +129,7 @@ void GeodesicSweep(const std::vector<size_t>& offset, const std::vector<int>& ad
     auto& mine = found[static_cast<size_t>(omp_get_thread_num())];
 #pragma omp for schedule(static)
     for (long lp = 0; lp < static_cast<long>(parts); ++lp) {
-      const size_t p = static_cast<size_t>(lp), lo = n * p / parts, hi = n * (p + 1) / parts;
+      const auto [lo, hi] = range(lp);
       for (size_t u = lo; u < hi; ++u) {
         if (label[u] < 0) continue;
         for (size_t a = offset[u]; a < offset[u + 1]; ++a) {
