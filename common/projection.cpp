@@ -1,5 +1,7 @@
 #include "common/projection.h"
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 
 #include "common/errors.h"
@@ -14,10 +16,90 @@ ProjectionOptions RelativeProjection(double diagonal, double tol_rel, double flo
   return options;
 }
 
-void CheckRelativeProjection(double tol_rel, double floor_rel, int max_iterations) {
+void CheckRelativeProjection(double tol_rel, double floor_rel, int max_iterations, double twin_factor) {
   if (!(tol_rel > 0.0 && tol_rel < 0.1)) throw UsageError("--proj-tol-rel must be in (0, 0.1)");
   if (!(floor_rel >= 0.0 && floor_rel < 0.1)) throw UsageError("--proj-floor-rel must be in [0, 0.1)");
   if (max_iterations < 1) throw UsageError("--proj-max-iters must be at least 1");
+  if (!(twin_factor >= 0.0 && twin_factor <= 10.0)) throw UsageError("--proj-twin-factor must be in [0, 10]");
+}
+
+double EstimateTwinWithin(const ProjectionResult& result, double tolerance, double factor) {
+  if (!(factor > 0.0)) return 0.0;
+  std::vector<double> floors;
+  for (size_t i = 0; i < result.converged.size(); ++i)
+    if (result.converged[i] && result.distance[i] >= tolerance) floors.push_back(result.distance[i]);
+  if (floors.size() < 16 || static_cast<double>(floors.size()) < kTwinMinFloorShare * static_cast<double>(result.num_converged))
+    return 0.0;
+  const size_t q = static_cast<size_t>(0.99 * static_cast<double>(floors.size() - 1));
+  std::nth_element(floors.begin(), floors.begin() + static_cast<long>(q), floors.end());
+  return factor * floors[q];
+}
+
+void MergeTwinSheets(const Udf& udf, std::vector<Vec3>& points, ProjectionResult& result, double tolerance,
+                     double within) {
+  // Probes at two distances: a tilted gradient reads a probe short by r (1 - cos tilt), so a probe at r
+  // tells twins apart only beyond 0.13 r; the near one finds the close twins, the far one the rest.
+  static constexpr std::array<double, 3> kScales = {0.25, 0.5, 1.0};
+  std::vector<size_t> probed;
+  std::vector<Vec3> probes, dir;
+  for (size_t i = 0; i < points.size(); ++i) {
+    // Points at a floor too: a step that ends just past a zero sheet (the error varies along it) converges at
+    // that V's bottom. A real floor (e > 0) reads within + e on both sides and stays.
+    if (!result.converged[i] || result.gradient[i].squaredNorm() < 0.25) continue;
+    const Vec3 u = result.gradient[i].normalized();
+    probed.push_back(i);
+    dir.push_back(u);
+    for (double scale : kScales) {
+      probes.push_back(points[i] + scale * within * u);
+      probes.push_back(points[i] - scale * within * u);
+    }
+  }
+  if (probed.empty()) return;
+  std::vector<double> d;
+  std::vector<Vec3> g;
+  udf.Evaluate(probes, d, g);
+  // A probe counts when it read less than within cos 30° with its gradient within 45° of its own direction.
+  const double passed = std::cos(M_PI / 6.0), onward = std::cos(M_PI / 4.0);
+  std::vector<size_t> moved;
+  std::vector<Vec3> target;
+  std::vector<double> half;
+  for (size_t k = 0; k < probed.size(); ++k) {
+    double best_t = 0.0;
+    Vec3 best_probe = Vec3::Zero();
+    for (size_t scale = 0; scale < kScales.size() && best_t == 0.0; ++scale)
+      for (int side = 0; side < 2; ++side) {
+        const size_t j = (kScales.size() * k + scale) * 2 + static_cast<size_t>(side);
+        const double r = kScales[scale] * within;
+        const Vec3 v = side == 0 ? dir[k] : Vec3(-dir[k]);
+        if (!std::isfinite(d[j]) || !(d[j] < passed * r) || g[j].dot(v) < onward * g[j].norm()) continue;
+        const double t = r - d[j];
+        if (best_t == 0.0 || t < best_t) best_t = t, best_probe = probes[j];
+      }
+    if (best_t == 0.0) continue;
+    moved.push_back(probed[k]);
+    target.push_back(best_probe);
+  }
+  if (moved.empty()) return;
+  // The twin itself, from that probe: where its own error puts it, not where the probe's error said.
+  ProjectionOptions to_twin;
+  to_twin.tolerance = tolerance;
+  to_twin.max_iterations = 8;
+  const ProjectionResult twin = ProjectToZeroSet(udf, target, to_twin, Monitor::Null());
+  for (size_t k = 0; k < moved.size(); ++k) {
+    const double t = (target[k] - points[moved[k]]).norm();
+    half.push_back(0.5 * t);
+    target[k] = 0.5 * (target[k] + points[moved[k]]);
+    if (!twin.converged[k] || !(t < within)) half.back() = -1.0;
+  }
+  udf.Evaluate(target, d, g);
+  for (size_t k = 0; k < moved.size(); ++k) {
+    if (!(std::abs(d[k] - half[k]) <= 0.5 * half[k])) continue;  // not a ridge: |d - t/2| > t/4
+    const size_t i = moved[k];
+    points[i] = target[k];
+    result.distance[i] = d[k];
+    result.gradient[i] = g[k];
+    ++result.num_merged;
+  }
 }
 
 ProjectionResult ProjectToZeroSet(const Udf& udf, std::vector<Vec3>& points, const ProjectionOptions& options,
@@ -35,6 +117,7 @@ ProjectionResult ProjectToZeroSet(const Udf& udf, std::vector<Vec3>& points, con
   // Per point: the gradient its last ordinary step followed (zero before the first), and whether the last
   // move went to a kink's bottom.
   std::vector<Vec3> stepped_along(n, Vec3::Zero());
+  std::vector<double> step_length(n, 0.0);  // of the last ordinary step
   std::vector<char> at_kink(n, 0);
   std::vector<Vec3> batch;
   std::vector<double> d;
@@ -49,7 +132,11 @@ ProjectionResult ProjectToZeroSet(const Udf& udf, std::vector<Vec3>& points, con
       const size_t i = active[k];
       result.distance[i] = d[k];
       result.gradient[i] = g[k];
-      if (d[k] < options.tolerance || (at_kink[i] && d[k] < options.floor_tolerance)) {
+      // A kink's bottom found from a step much longer than its value is refined by one more bracket: the
+      // bottom lies where both sides' values meet, and the field's error varies along a long step.
+      const bool at_floor = at_kink[i] && d[k] < options.floor_tolerance &&
+                            (step_length[i] <= 4.0 * d[k] || g[k].squaredNorm() < 0.25);
+      if (d[k] < options.tolerance || at_floor) {
         result.converged[i] = 1;
         result.num_at_floor += d[k] >= options.tolerance;
         continue;
@@ -61,6 +148,7 @@ ProjectionResult ProjectToZeroSet(const Udf& udf, std::vector<Vec3>& points, con
       } else {
         points[i] -= d[k] * g[k];
         stepped_along[i] = g[k];
+        step_length[i] = d[k] * g[k].norm();
         at_kink[i] = 0;
       }
       if (!domain.Contains(points[i], escape)) continue;
@@ -70,6 +158,13 @@ ProjectionResult ProjectToZeroSet(const Udf& udf, std::vector<Vec3>& points, con
     monitor.Debug("projection step " + std::to_string(iter) + ": " + std::to_string(active.size()) + " points moving");
   }
   for (char c : result.converged) result.num_converged += c ? 1 : 0;
+  result.twin_within = options.twin_within > 0.0 ? options.twin_within
+                                                 : EstimateTwinWithin(result, options.tolerance, options.twin_factor);
+  if (result.twin_within > 0.0) {
+    MergeTwinSheets(udf, points, result, options.tolerance, result.twin_within);
+    monitor.Debug("twin sheets within " + std::to_string(result.twin_within) + ": " +
+                  std::to_string(result.num_merged) + " points moved to the ridge between them");
+  }
   return result;
 }
 

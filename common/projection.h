@@ -13,6 +13,14 @@ struct ProjectionOptions {
   /// (0: only `tolerance` counts). Learned and sampled fields have such a floor instead of zeros.
   double floor_tolerance = 0.0;
   int max_iterations = 50; ///< steps x <- x - d(x) n(x) before a point is given up
+  /// absolute: two zero sheets closer than this are one surface seen through a field error, and a point that
+  /// converges on one of them moves to the ridge midway (MergeTwinSheets). 0: measured per call when
+  /// twin_factor > 0, else off.
+  double twin_within = 0.0;
+  /// When twin_within is 0: twin_within = twin_factor x the 99th percentile of the floor values of the call's
+  /// points, if at least kTwinMinFloorShare of the converged points converged at a floor (EstimateTwinWithin).
+  /// 0: never merge.
+  double twin_factor = 0.0;
 };
 
 struct ProjectionResult {
@@ -21,15 +29,26 @@ struct ProjectionResult {
   std::vector<Vec3> gradient;     ///< n at the final position
   size_t num_converged = 0;
   size_t num_at_floor = 0;        ///< of those, converged at a kink's bottom above `tolerance`
+  double twin_within = 0.0;       ///< the twin separation used: given, measured from the floors, or 0 (none)
+  size_t num_merged = 0;          ///< of the converged points, moved from a zero sheet to the ridge to its twin
 };
+
+/// The share of converged points at a floor from which the floors are taken for a measure of the field's error.
+inline constexpr double kTwinMinFloorShare = 0.05;
 
 /// The stages' --proj-tol-rel, --proj-floor-rel and --proj-max-iters (relative to the domain diagonal) as
 /// the absolute options for a domain of diagonal `diagonal`.
 ProjectionOptions RelativeProjection(double diagonal, double tol_rel, double floor_rel, int max_iterations);
 
-/// Throws UsageError naming the option unless tol_rel is in (0, 0.1), floor_rel in [0, 0.1) and
-/// max_iterations at least 1.
-void CheckRelativeProjection(double tol_rel, double floor_rel, int max_iterations);
+/// Throws UsageError naming the option unless tol_rel is in (0, 0.1), floor_rel in [0, 0.1),
+/// max_iterations at least 1 and twin_factor in [0, 10].
+void CheckRelativeProjection(double tol_rel, double floor_rel, int max_iterations, double twin_factor = 0.0);
+
+/// --proj-twin-factor's default and help line, the same in every stage.
+inline constexpr double kProjTwinFactor = 2.5;
+inline constexpr const char* kProjTwinFactorHelp =
+    "zero sheets closer than this x the field's measured floor (99th percentile) are one surface: points go to "
+    "the ridge between them (noisy fields; exact fields have no floor; 0: off)";
 
 /// --proj-floor-rel's help line, the same in every stage.
 inline constexpr const char* kProjFloorRelHelp =
@@ -48,8 +67,29 @@ inline constexpr const char* kProjFloorRelHelp =
 /// Points whose gradient is zero, or that leave the domain box by more than its diagonal, or that have not
 /// converged after max_iterations are marked unconverged (their positions are left where the iteration
 /// stopped). Evaluations are batched over all active points.
+/// Then, when options.twin_within (given, or measured by EstimateTwinWithin) is positive, MergeTwinSheets.
 /// \pre options.tolerance > 0
 ProjectionResult ProjectToZeroSet(const Udf& udf, std::vector<Vec3>& points, const ProjectionOptions& options,
                                   Monitor& monitor);
+
+/// The twin separation a field's floors imply: `factor` x the 99th percentile of the values at which points
+/// converged at a kink's bottom, or 0 when fewer than kTwinMinFloorShare of the converged points (or fewer
+/// than 16) did. Why the floors measure the twins: a field |d + e| with a smooth error e bottoms out at e where
+/// e > 0 and has two zero sheets 2|e| apart where e < 0; for an error symmetric about 0 the separations are
+/// distributed as twice the floors. An exact field has no floors and gets 0.
+double EstimateTwinWithin(const ProjectionResult& result, double tolerance, double factor);
+
+/// Where a field's zero set is a surface doubled by an error (|d + e| with e < 0: zeros at d = |e| either
+/// side, a ridge of height |e| on the surface between them), moves each converged point that lies on a zero
+/// sheet to the ridge: it probes x +- within u (u: the unit gradient there); a probe
+/// that has passed a twin sheet at separation t < within reads d = within - t with its gradient pointing on
+/// along the probe (a single sheet reads within, a sheet across the probe a gradient across it). The point moves
+/// by t/2 towards the nearer twin when t > 0.13 within (a probe tilted by 30° reads within cos 30°), and stays
+/// unless the field there reads t/2 within a quarter of t (the ridge). Two or three evaluations per point probed;
+/// `result` gets the new positions' values and gradients and counts them in num_merged. Sheets closer than
+/// `within` that are really there (a wall thinner than the field's error) become their mid-surface.
+/// \pre within > 0
+void MergeTwinSheets(const Udf& udf, std::vector<Vec3>& points, ProjectionResult& result, double tolerance,
+                     double within);
 
 }  // namespace voroudf

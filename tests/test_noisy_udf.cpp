@@ -190,5 +190,120 @@ TEST(Projection, SeedsOfANoisySphereAreKeptAndNearIt) {
   EXPECT_LT(SampleSeeds(*noisy, options, Monitor::Null()).size(), 700u);
 }
 
+// |d + e| for the plane z = 0 with a constant error: e = +a (a floor of height a) where x < 0, e = -a (two
+// zero sheets at z = +-a, a ridge of height a on the plane between them) where x >= 0. Gradients as the
+// noisy: wrapper gives them: the plane's, times the sign of d + e.
+class FloorAndTwins final : public Udf {
+ public:
+  explicit FloorAndTwins(double a, bool floor_half = true) : a_(a), floor_half_(floor_half) {}
+  void EvaluateChunk(const Vec3* p, size_t count, double* d, Vec3* g) const override {
+    for (size_t i = 0; i < count; ++i) {
+      const double z = p[i].z(), e = floor_half_ && p[i].x() < 0 ? a_ : -a_;
+      d[i] = std::abs(std::abs(z) + e);
+      g[i] = Vec3(0, 0, (z < 0 ? -1.0 : 1.0) * (std::abs(z) + e < 0 ? -1.0 : 1.0));
+    }
+  }
+  Box Domain() const override { return {Vec3::Constant(-1), Vec3::Constant(1)}; }
+  std::string Describe() const override { return "floor and twins"; }
+
+ private:
+  double a_;
+  bool floor_half_;
+};
+
+std::vector<Vec3> SlabPoints(size_t n, double half_height, uint64_t seed) {
+  Rng rng(seed, 0);
+  std::vector<Vec3> p(n);
+  for (auto& x : p) x = Vec3(rng.Uniform(-0.5, 0.5), rng.Uniform(-0.5, 0.5), rng.Uniform(-half_height, half_height));
+  return p;
+}
+
+TEST(Projection, TwinSheetsOfAFieldWithAFloorGoToTheRidgeBetweenThem) {
+  const double a = 2e-3;
+  const FloorAndTwins udf(a);
+  const std::vector<Vec3> start = SlabPoints(600, 0.05, 4);
+  ProjectionOptions options;
+  options.tolerance = 1e-9;
+  options.floor_tolerance = 1e-2;
+  std::vector<Vec3> points = start;
+  const ProjectionResult plain = ProjectToZeroSet(udf, points, options, Monitor::Null());
+  size_t on_twins = 0;
+  for (size_t i = 0; i < points.size(); ++i)
+    if (plain.converged[i] && start[i].x() >= 0) on_twins += std::abs(std::abs(points[i].z()) - a) < 1e-9;
+  EXPECT_GT(on_twins, 250u);  // without merging: on a sheet a off the plane
+  EXPECT_EQ(plain.num_merged, 0u);
+
+  options.twin_factor = 2.5;
+  points = start;
+  const ProjectionResult r = ProjectToZeroSet(udf, points, options, Monitor::Null());
+  EXPECT_NEAR(r.twin_within, 2.5 * a, 1e-12);  // every floor reads a
+  EXPECT_EQ(r.num_converged, start.size());
+  EXPECT_GT(r.num_merged, 250u);
+  for (size_t i = 0; i < points.size(); ++i) {
+    EXPECT_LT(std::abs(points[i].z()), 1e-9) << "point " << i << " started at " << start[i].transpose();
+    EXPECT_NEAR(points[i].x(), start[i].x(), 1e-12);  // moved along the normal only
+  }
+}
+
+TEST(Projection, AnExactFieldsThinWallIsNotMergedForItHasNoFloor) {
+  const double a = 2e-3;
+  const FloorAndTwins udf(a, false);  // two real sheets 2a apart, no floor anywhere
+  std::vector<Vec3> points = SlabPoints(400, 0.05, 5);
+  ProjectionOptions options;
+  options.tolerance = 1e-9;
+  options.floor_tolerance = 1e-2;
+  options.twin_factor = 2.5;
+  const ProjectionResult r = ProjectToZeroSet(udf, points, options, Monitor::Null());
+  EXPECT_EQ(r.twin_within, 0.0);
+  EXPECT_EQ(r.num_merged, 0u);
+  for (size_t i = 0; i < points.size(); ++i) EXPECT_NEAR(std::abs(points[i].z()), a, 1e-9);
+}
+
+// |z| + f0 + c z: a floor whose error varies along the normal, as a learned field's or noisy: one does.
+class SlantedFloor final : public Udf {
+ public:
+  void EvaluateChunk(const Vec3* p, size_t count, double* d, Vec3* g) const override {
+    for (size_t i = 0; i < count; ++i) {
+      d[i] = std::abs(p[i].z()) + 1e-3 + 0.2 * p[i].z();
+      g[i] = Vec3(0, 0, p[i].z() < 0 ? -1 : 1);
+    }
+  }
+  Box Domain() const override { return {Vec3::Constant(-1), Vec3::Constant(1)}; }
+  std::string Describe() const override { return "slanted floor"; }
+};
+
+TEST(Projection, AKinksBottomFoundFromALongStepIsRefined) {
+  // From 0.02-0.1 away the first bracket is long and the error's slope puts its bottom up to 6e-3 off;
+  // the refined bracket is a few times the floor long.
+  const SlantedFloor udf;
+  std::vector<Vec3> points = SlabPoints(300, 0.1, 6);
+  for (auto& p : points) p.z() = (p.z() < 0 ? -0.02 : 0.02) + p.z() * 0.8;
+  ProjectionOptions options;
+  options.tolerance = 1e-9;
+  options.floor_tolerance = 1e-2;
+  const ProjectionResult r = ProjectToZeroSet(udf, points, options, Monitor::Null());
+  EXPECT_EQ(r.num_at_floor, points.size());
+  for (const Vec3& p : points) EXPECT_LT(std::abs(p.z()), 5e-4);
+}
+
+TEST(Projection, TwinMergingBringsANoisySpheresSeedsNearer) {
+  // noisy:value=1e-3: the seeds' mean distance from the sphere, with the default --proj-twin-factor and off.
+  const auto noisy = OpenUdf("noisy:value=1e-3:shape:sphere");
+  const double sigma = 1e-3 * noisy->Domain().Diagonal();
+  SampleSeedsOptions options;
+  options.count = 1500;
+  auto mean_error = [&] {
+    const SeedCloud seeds = SampleSeeds(*noisy, options, Monitor::Null());
+    double sum = 0.0;
+    for (const Vec3& p : seeds.position) sum += std::abs(p.norm() - 0.5);
+    return sum / static_cast<double>(seeds.size()) / sigma;
+  };
+  const double merged = mean_error();
+  options.proj_twin_factor = 0.0;
+  const double apart = mean_error();
+  EXPECT_LT(merged, 0.25);
+  EXPECT_GT(apart, 0.35);
+}
+
 }  // namespace
 }  // namespace voroudf

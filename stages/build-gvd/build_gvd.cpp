@@ -82,7 +82,7 @@ void BuildGvdOptions::Check() const {
   if (!(eps_grad > 0.0 && eps_grad <= 1.0)) throw UsageError("--eps-grad must be in (0, 1]");
   if (!(eps_grad_both > 0.0 && eps_grad_both <= 1.0)) throw UsageError("--eps-grad-both must be in (0, 1]");
   if (curve_samples != "tangent" && curve_samples != "ball") throw UsageError("--curve-samples must be tangent or ball");
-  CheckRelativeProjection(proj_tol_rel, proj_floor_rel, proj_max_iters);
+  CheckRelativeProjection(proj_tol_rel, proj_floor_rel, proj_max_iters, proj_twin_factor);
 }
 
 namespace {
@@ -470,8 +470,14 @@ GvdResult BuildGvd(const Udf& udf, const SeedCloud& seeds, const BuildGvdOptions
   std::vector<Vec3> samples = DrawSamples(seeds, box, options, &in_space, &tangent);
   const size_t total = samples.size();
   stats.samples_drawn = total;
-  const ProjectionOptions proj = RelativeProjection(diag, options.proj_tol_rel, options.proj_floor_rel, options.proj_max_iters);
+  ProjectionOptions proj = RelativeProjection(diag, options.proj_tol_rel, options.proj_floor_rel, options.proj_max_iters);
+  proj.twin_factor = options.proj_twin_factor;
   ProjectionResult projected = ProjectToZeroSet(udf, samples, proj, monitor);
+  proj.twin_within = projected.twin_within;  // the redrawn samples see the same field
+  if (projected.twin_within > 0.0)
+    monitor.Info(Format("the field has a floor: zero sheets within %.3g (%.3g x diagonal) taken for one, %zu samples "
+                        "moved to the ridge between them", projected.twin_within, projected.twin_within / diag,
+                        projected.num_merged));
   stats.samples_projected = projected.num_converged;
   if (options.curve_samples == "tangent")
     stats.samples_redrawn = RedrawInTangentDiscs(udf, seeds, tangent, in_space, proj, samples, projected, monitor);

@@ -8,6 +8,7 @@
 #include <string>
 
 #include "common/monitor.h"
+#include "common/projection.h"
 #include "common/types.h"
 #include "common/udf.h"
 #include "formats/labels_io.h"
@@ -59,6 +60,8 @@ struct BuildGvdOptions {
   double proj_tol_rel = 1e-5;  ///< samples converge once d < proj_tol_rel * diagonal (--proj-tol-rel)
   int proj_max_iters = 50;     ///< projection steps before a sample is dropped (--proj-max-iters)
   double proj_floor_rel = 1e-2;  ///< a kink's bottom with d below this x diagonal is on the zero set (--proj-floor-rel)
+  /// zero sheets closer than this x the field's measured floor are one surface (common/projection.h) (--proj-twin-factor)
+  double proj_twin_factor = kProjTwinFactor;
 
   /// Throws UsageError for values that cannot work.
   void Check() const;

@@ -47,6 +47,7 @@ int main(int argc, char** argv) {
   app.add_option("--proj-tol-rel", options.proj_tol_rel, "projection tolerance on d, relative to the diagonal");
   app.add_option("--proj-max-iters", options.proj_max_iters, "projection steps before a sample is dropped");
   app.add_option("--proj-floor-rel", options.proj_floor_rel, voroudf::kProjFloorRelHelp);
+  app.add_option("--proj-twin-factor", options.proj_twin_factor, voroudf::kProjTwinFactorHelp);
 
   return cli.Run(argc, argv, [&] { options.Check(); }, [&](voroudf::Monitor& monitor) {
     const auto udf = cli.OpenUdf(monitor);

@@ -53,6 +53,7 @@ int main(int argc, char** argv) {
   app.add_option("--proj-tol-rel", o.proj_tol_rel, "projection tolerance on d, relative to the diagonal");
   app.add_option("--proj-max-iters", o.proj_max_iters, "projection steps before a move is undone");
   app.add_option("--proj-floor-rel", o.proj_floor_rel, voroudf::kProjFloorRelHelp);
+  app.add_option("--proj-twin-factor", o.proj_twin_factor, voroudf::kProjTwinFactorHelp);
 
   return cli.Run(argc, argv, [&] { o.Check(); }, [&](voroudf::Monitor& monitor) {
     const auto udf = cli.OpenUdf(monitor);

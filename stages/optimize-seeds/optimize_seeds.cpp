@@ -57,7 +57,7 @@ void OptimizeSeedsOptions::Check() const {
   if (l1_max_steps < 1) throw UsageError("--l1-max-steps must be at least 1");
   if (!(move_tol >= 0.0 && move_tol < 1.0)) throw UsageError("--move-tol must be in [0, 1)");
   if (!(outer_tol >= 0.0 && outer_tol < 1.0)) throw UsageError("--outer-tol must be in [0, 1)");
-  CheckRelativeProjection(proj_tol_rel, proj_floor_rel, proj_max_iters);
+  CheckRelativeProjection(proj_tol_rel, proj_floor_rel, proj_max_iters, proj_twin_factor);
 }
 
 namespace {
@@ -87,6 +87,7 @@ class Optimizer {
     cell_options_.early_samples = options.early_samples;
     cell_options_.early_rank_threshold = 0.5 * options.rank_threshold;
     projection_ = RelativeProjection(diagonal_, options.proj_tol_rel, options.proj_floor_rel, options.proj_max_iters);
+    projection_.twin_factor = options.proj_twin_factor;
   }
 
   // Projects `moved` onto the zero set; a seed whose projection fails goes back to `previous` (which is on
@@ -536,6 +537,8 @@ class Optimizer {
   double last_acceptance() const { return last_acceptance_; }
   double normal_spread() const { return normal_spread_; }
   const ProjectionOptions& projection() const { return projection_; }
+  /// Every later projection takes zero sheets closer than this for one (Prepare measures it).
+  void SetTwinWithin(double within) { projection_.twin_within = within; }
 
  private:
   const Udf& udf_;
@@ -578,8 +581,10 @@ void CountRanks(const SeedState& s, OuterIterationReport& report) {
   report.mean_abs_udf = sum / static_cast<double>(s.position.size());
 }
 
-// Input seeds on the zero set, in input order, without exact duplicates (their repulsion has no direction).
-SeedState Prepare(const Udf& udf, const SeedCloud& input, const ProjectionOptions& projection, Monitor& monitor) {
+// Input seeds on the zero set, in input order, without exact duplicates (their repulsion has no direction);
+// *twin_within: the twin separation their projection measured (common/projection.h).
+SeedState Prepare(const Udf& udf, const SeedCloud& input, const ProjectionOptions& projection, Monitor& monitor,
+                  double* twin_within) {
   if (input.size() < 2)
     throw InputError("input seeds", "has " + std::to_string(input.size()) + " seed(s); optimize-seeds needs at least 2");
   std::vector<size_t> order(input.size());
@@ -601,6 +606,11 @@ SeedState Prepare(const Udf& udf, const SeedCloud& input, const ProjectionOption
 
   ProjectionResult r = ProjectToZeroSet(udf, points, projection, monitor);
   SeedState s;
+  *twin_within = r.twin_within;
+  if (r.twin_within > 0.0)
+    monitor.Info(Format("the field has a floor: zero sheets within %.3g (%.3g x diagonal) taken for one, %.0f seeds "
+                        "moved to the ridge between them", r.twin_within, r.twin_within / udf.Domain().Diagonal(),
+                        static_cast<double>(r.num_merged)));
   for (size_t i = 0; i < points.size(); ++i) {
     if (!r.converged[i]) continue;
     s.position.push_back(points[i]);
@@ -623,7 +633,9 @@ SeedCloud OptimizeSeeds(const Udf& udf, const SeedCloud& input, const OptimizeSe
   using Clock = std::chrono::steady_clock;
   const auto start = Clock::now();
   Optimizer opt(udf, options, monitor);
-  SeedState s = Prepare(udf, input, opt.projection(), monitor);
+  double twin_within = 0.0;
+  SeedState s = Prepare(udf, input, opt.projection(), monitor, &twin_within);
+  opt.SetTwinWithin(twin_within);
   const size_t n = s.position.size();
   const auto [spacing_in, cv_in] = opt.SpacingStats(s.position);
   // Buckets of 1.5 spacings: a cell's ball (radius ~0.8 spacing) meets 8-27, whose points are scanned in one

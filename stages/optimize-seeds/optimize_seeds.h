@@ -6,6 +6,7 @@
 #include <string>
 
 #include "common/monitor.h"
+#include "common/projection.h"
 #include "common/udf.h"
 #include "formats/seeds_io.h"
 
@@ -73,6 +74,7 @@ struct OptimizeSeedsOptions {
   double proj_tol_rel = 1e-5;     ///< projection tolerance on d, relative to the diagonal (as sample-seeds) (--proj-tol-rel)
   int proj_max_iters = 50;        ///< projection steps before a move is undone (--proj-max-iters)
   double proj_floor_rel = 1e-2;   ///< a kink's bottom with d below this x diagonal is on the zero set (as sample-seeds) (--proj-floor-rel)
+  double proj_twin_factor = kProjTwinFactor;  ///< zero sheets closer than this x the measured floor are one surface (as sample-seeds) (--proj-twin-factor)
 
   /// Throws UsageError for values that cannot work.
   void Check() const;

@@ -25,6 +25,7 @@ int main(int argc, char** argv) {
   app.add_option("--proj-max-iters", options.proj_max_iters, "projection steps before a seed is dropped");
   app.add_option("--thin-boost", options.thin_boost, "up to this many times the seeds where the part is thinner than two spacings (1: uniform)");
   app.add_option("--proj-floor-rel", options.proj_floor_rel, voroudf::kProjFloorRelHelp);
+  app.add_option("--proj-twin-factor", options.proj_twin_factor, voroudf::kProjTwinFactorHelp);
 
   return cli.Run(argc, argv, [&] { options.Check(); }, [&](voroudf::Monitor& monitor) {
     const auto udf = cli.OpenUdf(monitor);

@@ -17,7 +17,7 @@ namespace voroudf {
 void SampleSeedsOptions::Check() const {
   if (count == 0) throw UsageError("--count must be at least 1");
   if (count > 100000000) throw UsageError("--count must be at most 1e8");
-  CheckRelativeProjection(proj_tol_rel, proj_floor_rel, proj_max_iters);
+  CheckRelativeProjection(proj_tol_rel, proj_floor_rel, proj_max_iters, proj_twin_factor);
   if (!(band_rel >= 0.0)) throw UsageError("--band-rel must be >= 0");
   if (!(dedup_rel >= 0.0 && dedup_rel < 0.1)) throw UsageError("--dedup-rel must be in [0, 0.1)");
   if (!(thin_boost >= 1.0 && thin_boost <= 64.0)) throw UsageError("--thin-boost must be in [1, 64]");
@@ -149,8 +149,9 @@ SeedCloud SampleSeeds(const Udf& udf, const SampleSeedsOptions& options, Monitor
   if (options.thin_boost > 1.0)  // a pool to choose from (ChooseForThinParts)
     draw_options.count = static_cast<size_t>(std::ceil(options.thin_boost)) * options.count;
   std::vector<Vec3> points = DrawInBand(udf, box, draw_options, monitor);
-  const ProjectionOptions proj =
+  ProjectionOptions proj =
       RelativeProjection(box.Diagonal(), options.proj_tol_rel, options.proj_floor_rel, options.proj_max_iters);
+  proj.twin_factor = options.proj_twin_factor;
   const ProjectionResult r = ProjectToZeroSet(udf, points, proj, monitor);
 
   std::vector<size_t> converged;

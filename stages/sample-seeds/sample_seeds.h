@@ -5,6 +5,7 @@
 #include <cstdint>
 
 #include "common/monitor.h"
+#include "common/projection.h"
 #include "common/udf.h"
 #include "formats/seeds_io.h"
 
@@ -26,6 +27,9 @@ struct SampleSeedsOptions {
   /// --proj-floor-rel: a seed at the bottom of a kink of d (common/projection.h) with d below this x diagonal
   /// has converged: learned and sampled fields have such a floor instead of zeros. 0: off.
   double proj_floor_rel = 1e-2;
+  /// --proj-twin-factor: zero sheets closer than this x the field's measured floor are one surface
+  /// (common/projection.h, MergeTwinSheets); exact fields have no floor. 0: off.
+  double proj_twin_factor = kProjTwinFactor;
   /// --thin-boost B: draw ceil(B) x count points and choose count of them, up to B times likelier where the
   /// part is thinner than 2 spacings (ThinSeedWeights in thin_sizing.h), so flat parts give seeds to thin ones;
   /// 1: uniform, the paper.
