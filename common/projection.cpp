@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
 
 #include "common/errors.h"
 
@@ -37,8 +38,8 @@ double EstimateTwinWithin(const ProjectionResult& result, double tolerance, doub
 
 void MergeTwinSheets(const Udf& udf, std::vector<Vec3>& points, ProjectionResult& result, double tolerance,
                      double within) {
-  // Probes at two distances: a tilted gradient reads a probe short by r (1 - cos tilt), so a probe at r
-  // tells twins apart only beyond 0.13 r; the near one finds the close twins, the far one the rest.
+  // Probes at three distances: a tilted gradient reads a probe short by r (1 - cos tilt), so a probe at r
+  // tells twins apart only beyond 0.13 r; the near ones find the close twins, the far one the rest.
   static constexpr std::array<double, 3> kScales = {0.25, 0.5, 1.0};
   std::vector<size_t> probed;
   std::vector<Vec3> probes, dir;
@@ -100,6 +101,13 @@ void MergeTwinSheets(const Udf& udf, std::vector<Vec3>& points, ProjectionResult
     result.gradient[i] = g[k];
     ++result.num_merged;
   }
+}
+
+std::string TwinSheetsSummary(const ProjectionResult& result, double diagonal, const std::string& what) {
+  char line[200];
+  std::snprintf(line, sizeof line, "the field has a floor: zero sheets within %.3g (%.3g x diagonal) taken for one, %zu ",
+                result.twin_within, result.twin_within / diagonal, result.num_merged);
+  return line + what + " moved to the ridge between them";
 }
 
 ProjectionResult ProjectToZeroSet(const Udf& udf, std::vector<Vec3>& points, const ProjectionOptions& options,

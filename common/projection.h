@@ -1,5 +1,6 @@
 #pragma once
 // Projection of points onto the zero set of a UDF, shared by sample-seeds, optimize-seeds and build-gvd.
+#include <string>
 #include <vector>
 
 #include "common/monitor.h"
@@ -81,13 +82,17 @@ double EstimateTwinWithin(const ProjectionResult& result, double tolerance, doub
 
 /// Where a field's zero set is a surface doubled by an error (|d + e| with e < 0: zeros at d = |e| either
 /// side, a ridge of height |e| on the surface between them), moves each converged point that lies on a zero
-/// sheet to the ridge: it probes x +- within u (u: the unit gradient there); a probe
-/// that has passed a twin sheet at separation t < within reads d = within - t with its gradient pointing on
-/// along the probe (a single sheet reads within, a sheet across the probe a gradient across it). The point moves
-/// by t/2 towards the nearer twin when t > 0.13 within (a probe tilted by 30° reads within cos 30°), and stays
-/// unless the field there reads t/2 within a quarter of t (the ridge). Two or three evaluations per point probed;
-/// `result` gets the new positions' values and gradients and counts them in num_merged. Sheets closer than
+/// sheet to the ridge: it probes x +- r u at r = within/4, within/2 and within (u: the unit gradient there);
+/// a probe that has passed a twin sheet reads d < r cos 30° with its gradient pointing on along the probe (a
+/// single sheet reads about r, a sheet across the probe gives a gradient across it). From the nearest such
+/// probe the twin itself is found by projection; the point moves to the midpoint when the two are less than
+/// `within` apart and the field there reads half their separation t within a quarter of t (the ridge). Six
+/// evaluations per point probed, and a few more per point moved; `result` gets the new positions' values and gradients and counts them in num_merged. Sheets closer than
 /// `within` that are really there (a wall thinner than the field's error) become their mid-surface.
+/// The stages' log line for a projection that merged twin sheets: "the field has a floor: ...", naming the
+/// separation (absolute and x `diagonal`) and how many `what` (seeds, samples) moved.
+std::string TwinSheetsSummary(const ProjectionResult& result, double diagonal, const std::string& what);
+
 /// \pre within > 0
 void MergeTwinSheets(const Udf& udf, std::vector<Vec3>& points, ProjectionResult& result, double tolerance,
                      double within);

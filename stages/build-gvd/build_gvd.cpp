@@ -475,9 +475,7 @@ GvdResult BuildGvd(const Udf& udf, const SeedCloud& seeds, const BuildGvdOptions
   ProjectionResult projected = ProjectToZeroSet(udf, samples, proj, monitor);
   proj.twin_within = projected.twin_within;  // the redrawn samples see the same field
   if (projected.twin_within > 0.0)
-    monitor.Info(Format("the field has a floor: zero sheets within %.3g (%.3g x diagonal) taken for one, %zu samples "
-                        "moved to the ridge between them", projected.twin_within, projected.twin_within / diag,
-                        projected.num_merged));
+    monitor.Info(TwinSheetsSummary(projected, diag, "samples"));
   stats.samples_projected = projected.num_converged;
   if (options.curve_samples == "tangent")
     stats.samples_redrawn = RedrawInTangentDiscs(udf, seeds, tangent, in_space, proj, samples, projected, monitor);

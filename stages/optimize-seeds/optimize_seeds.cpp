@@ -608,9 +608,7 @@ SeedState Prepare(const Udf& udf, const SeedCloud& input, const ProjectionOption
   SeedState s;
   *twin_within = r.twin_within;
   if (r.twin_within > 0.0)
-    monitor.Info(Format("the field has a floor: zero sheets within %.3g (%.3g x diagonal) taken for one, %.0f seeds "
-                        "moved to the ridge between them", r.twin_within, r.twin_within / udf.Domain().Diagonal(),
-                        static_cast<double>(r.num_merged)));
+    monitor.Info(TwinSheetsSummary(r, udf.Domain().Diagonal(), "seeds"));
   for (size_t i = 0; i < points.size(); ++i) {
     if (!r.converged[i]) continue;
     s.position.push_back(points[i]);
