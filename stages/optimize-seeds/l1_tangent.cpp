@@ -293,6 +293,18 @@ TangentRank ComputeTangentRank(const Vec3* normals, size_t count, double tau) {
   return result;
 }
 
+Vec3 StepAcrossCurve(const Vec3& y, const TangentRank& r, const Vec3* gradients, size_t count, int min_third,
+                     double min_cos) {
+  if (r.rank != 2) return y;
+  const Vec3 t = r.v.col(2);
+  int third = 0;
+  for (size_t m = 0; m < count && third < min_third; ++m) {
+    const double len2 = gradients[m].squaredNorm();
+    if (len2 >= 0.25 && std::abs(gradients[m].dot(t)) >= min_cos * std::sqrt(len2)) ++third;
+  }
+  return third >= min_third ? y : Vec3(y - t.dot(y) * t);
+}
+
 double UnexplainedNormalSpread(const std::vector<TangentRank>& ranks) {
   std::vector<double> ratio;
   ratio.reserve(ranks.size());

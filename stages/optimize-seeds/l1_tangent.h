@@ -90,6 +90,21 @@ struct TangentRank {
 /// \pre 0 < tau < 1
 TangentRank ComputeTangentRank(const Vec3* normals, size_t count, double tau);
 
+/// The L1 step of a curve seed across its curve only (not in the paper; docs/optimize-seeds.md, "Curve
+/// seeds step across their curve"). The step y of a seed whose cell has rank 2 loses its component along the
+/// null direction t = r.v.col(2) (the curve's tangent), unless at least `min_third` of the cell's gradients
+/// n have |n·t| ≥ min_cos·|n|: a third plane, a corner or a kink of the curve ahead, onto which the step must
+/// stay free to go. Along a curve the L1 minimum is otherwise set by how the samples fall, not by the
+/// surface (on a curved edge the tangent planes of the curved face meet the other face's near the samples'
+/// median; on a field with value errors, where the error's plane families cross), and the steps of
+/// neighbouring curve seeds meet there; spacing along a curve is the repulsion's work (it moves a curve
+/// seed along t). min_cos = 0.3 (17.5° out of the curve's normal plane) lies above what gradient errors of
+/// 15° give (sin 15° = 0.26) and below the kinks and corners of CAD curves.
+/// \param gradients the cell's sample gradients (those shorter than 0.5 are skipped, as in the L1 terms)
+/// Seeds of another rank get y back unchanged.
+Vec3 StepAcrossCurve(const Vec3& y, const TangentRank& r, const Vec3* gradients, size_t count, int min_third = 1,
+                     double min_cos = 0.3);
+
 /// The spread of sample normals that no surface explains, ν: the median over cells of s₃/s₁. A sheet or a
 /// crease leaves s₃ = 0 with exact gradients; gradient errors (a learned field's) add about the same ν to
 /// every singular value below s₁, in every cell, so the median over a surface that is mostly sheets and

@@ -42,6 +42,8 @@ void OptimizeSeedsOptions::Check() const {
   if (!(max_step >= 0.0 && max_step <= 100.0)) throw UsageError("--max-step must be in [0, 100]");
   if (cell_samples != "pool" && cell_samples != "fresh") throw UsageError("--cell-samples must be pool or fresh");
   if (repulsion_cells != "every" && repulsion_cells != "first") throw UsageError("--repulsion-cells must be every or first");
+  if (l1_curve_step != "auto" && l1_curve_step != "free" && l1_curve_step != "across")
+    throw UsageError("--l1-curve-step must be auto, free or across");
   if (!(pool_layers >= 1 && pool_layers <= 64)) throw UsageError("--pool-layers must be in [1, 64]");
   if (!(sigma_max_spacing >= 0.0 && sigma_max_spacing <= 10.0)) throw UsageError("--sigma-max-spacing must be in [0, 10]");
   if (!(sigma_min_spacing >= 0.0 && sigma_min_spacing <= 10.0)) throw UsageError("--sigma-min-spacing must be in [0, 10]");
@@ -260,6 +262,8 @@ class Optimizer {
     std::vector<Vec3> moved(s.position);
     std::vector<int> sweeps(static_cast<size_t>(n), 0);
     std::vector<char> converged(static_cast<size_t>(n), 1);
+    const bool across_curves =
+        options_.l1_curve_step == "across" || (options_.l1_curve_step == "auto" && projection_.twin_within > 0.0);
 #pragma omp parallel
     {
       L1TangentProblem problem;
@@ -295,13 +299,15 @@ class Optimizer {
           }
         }
         const L1TangentSolution solution = SolveL1Tangent(problem, solver);
-        moved[i] = x0 + scale * solution.y;
+        const size_t first = cells.sample_offset[i], count = cells.sample_offset[i + 1] - first;
+        const Vec3 y = across_curves ? StepAcrossCurve(solution.y, s.rank[i], &cells.gradient[first], count) : solution.y;
+        moved[i] = x0 + scale * y;
         if (misfit_at_target) {
           // TangentMisfit at the target, from the solver's (merged, weighted) terms.
           double sum = 0.0, weight = 0.0;
           for (size_t k = 0; k < problem.a.size(); ++k) {
             const double w = problem.w.empty() ? 1.0 : problem.w[k];
-            sum += w * std::abs(problem.a[k].dot(solution.y) - problem.b[k]);
+            sum += w * std::abs(problem.a[k].dot(y) - problem.b[k]);
             weight += w;
           }
           (*misfit_at_target)[i] = scale * sum / weight;

@@ -67,6 +67,11 @@ struct OptimizeSeedsOptions {
   double feature_gap_max = 0.0;
   double max_step = 0.5;          ///< trust region: a repulsion round moves a seed at most this many σ (--max-step)
   double repulsion_cutoff = 3.0;  ///< neighbours interact within this many σ (kernel 1.1e-2 at 3σ) (--repulsion-cutoff)
+  /// --l1-curve-step: how the L1 step moves a curve seed (rank 2). "free": in every direction (the paper);
+  /// "across": only across its curve unless its cell sees a third plane (StepAcrossCurve); "auto" (default):
+  /// across on a field with a floor (value errors: the projection measured a twin width), free on an exact
+  /// field. Not in the paper, see docs/optimize-seeds.md ("Curve seeds step across their curve").
+  std::string l1_curve_step = "auto";
   double l1_tol_rel = 1e-6;       ///< L1 step solved to this position accuracy, relative to the diagonal (--l1-tol-rel)
   int l1_max_steps = 200;         ///< Newton steps of the L1 step's barrier method before it gives up (--l1-max-steps)
   double move_tol = 1e-3;         ///< an inner loop moving no seed farther than move_tol·σ "makes no update" (--move-tol)
