@@ -76,6 +76,16 @@ std::string Format(const char* format, double a = 0, double b = 0, double c = 0,
 constexpr int kFeatureChainRounds = 6;
 // ... before each outer iteration after the first, which moves the seeds anyway.
 constexpr int kFeatureChainRoundsInLoop = 2;
+// Where a gap between a corner and a curve seed is split, in spacings from the corner: beyond the one
+// spacing within which no curve seed is added, with room for the L1 step's move onto the curve.
+constexpr double kCornerGapSplit = 1.05;
+// Feature steps after the --feature-steps ones, taken while a feature seed's step would still move it more
+// than kFeatureSettledMove mean spacings (a seed ranked as a feature only after its neighbours stepped).
+constexpr int kFeatureExtraSteps = 2;
+constexpr double kFeatureSettledMove = 0.05;
+// After the last chain fill only the seeds this many mean spacings from an added seed take the feature
+// steps again: farther ones have cells the added seeds do not reach (a cell is about a spacing across).
+constexpr double kSettleReach = 2.0;
 // SeesTwoPlanes' contrast: between a uniform spread's 3.46 (one curved sheet) and the > 9 of two planes.
 constexpr double kCreaseContrast = 6.0;
 
@@ -361,7 +371,17 @@ class Optimizer {
         const Vec3 &pa = s.position[static_cast<size_t>(a)], &pb = s.position[static_cast<size_t>(b)];
         const double h = (pb - pa).norm();
         if (h < 2.5 * clearance || (bend_tol <= 0.0 && !(max_gap > 0.0 && h > max_gap))) continue;
-        trials.push_back({a, b, 0.5 * (pa + pb), Vec3::Zero()});
+        // A gap between a corner and a curve seed is split kCornerGapSplit spacings from the corner (its
+        // midpoint when that is farther), so that the added seed clears the corner rule below and both
+        // pieces of a gap up to 2 spacings are at most 1.5 spacings long.
+        Vec3 start = 0.5 * (pa + pb);
+        const bool a_corner = s.rank[static_cast<size_t>(a)].rank == 3, b_corner = s.rank[static_cast<size_t>(b)].rank == 3;
+        if (max_gap > 0.0 && h > max_gap && a_corner != b_corner) {
+          const Vec3 &corner = a_corner ? pa : pb, &other = a_corner ? pb : pa;
+          const double from_corner = std::min(std::max(0.5 * h, kCornerGapSplit * spacing), 0.7 * h);
+          start = corner + (from_corner / h) * (other - corner);
+        }
+        trials.push_back({a, b, start, Vec3::Zero()});
       }
       if (max_gap > 0.0)
         for (const auto& [a, direction] : links.ends)
@@ -389,6 +409,9 @@ class Optimizer {
       std::vector<Vec3> target = L1Step(trial, cells, false, nullptr, &movers);
       std::vector<Vec3> landed(target.begin() + static_cast<long>(n), target.end());
       const ProjectionResult r = ProjectToZeroSet(udf_, landed, projection_, Monitor::Null());
+      // Where each trial landed, its cell: the rank and the tangent that decide whether it stays.
+      for (size_t t = 0; t < landed.size(); ++t) trial.position[n + t] = landed[t];
+      Analyze(trial);
       const SeedIndex index(s.position);
       std::vector<int> near;
       for (size_t t = 0; t < landed.size(); ++t) {
@@ -419,7 +442,7 @@ class Optimizer {
         // Nor a curve seed within a spacing of a corner: a cell that near sees the corner's planes, so the seed
         // would be ranked 3 at the next analysis and stepped onto the corner, crowding it, and the thinning may
         // then keep the one beside the corner (open corners of crossing-planes and three-discs: a
-        // non-manifold edge 0.004–0.01 off the curve).
+        // non-manifold edge 0.004–0.01 off the curve, and 0.3–0.5 off it at a rim's corner).
         crowd_radius = std::max(crowd_radius, clearance);
         index.WithinRadius(landed[t], std::max(crowd_radius, spacing), near);
         bool crowded = false;
@@ -769,12 +792,44 @@ SeedCloud OptimizeSeeds(const Udf& udf, const SeedCloud& input, const OptimizeSe
   // (rank 1 -> 2) gets onto the curve in the next (crossing-planes and sphere-disc, 25 runs: seeds left
   // 0.003–0.007 off the curve with one step, none with three).
   // Step 7 as a function of the state: run again after step 8 (below).
-  auto settle_features = [&]() {
+  // A sheet seed beside a curve may see the second sheet only once its neighbours have stepped (rank 1 -> 2
+  // at a later analysis) and would end ranked as a feature but off it (sphere-disc, 200 seeds: 0.35
+  // spacings off the equator): the steps go on, kFeatureExtraSteps at most, while some feature seed's step
+  // would move it more than kFeatureSettledMove spacings.
+  // With `around` (the seeds added by step 8), only the seeds within kSettleReach spacings of one of them
+  // step: the others' cells are as the first settling left them.
+  auto settle_features = [&](const std::vector<Vec3>* around) {
     size_t crowded = 0;
-    for (int step = 0; step < (options.max_outer_iters > 0 ? options.feature_steps : 0); ++step) {
+    const int steps = options.max_outer_iters > 0 ? options.feature_steps : 0;
+    const int most = steps > 0 ? steps + (chains ? kFeatureExtraSteps : 0) : 0;
+    std::unique_ptr<SeedIndex> around_index;
+    if (around && !around->empty()) around_index = std::make_unique<SeedIndex>(*around);
+    std::vector<char> movers;
+    std::vector<int> near;
+    for (int step = 0;; ++step) {
       const CellSamples cells = opt.Analyze(s);
       std::vector<double> misfit;
-      std::vector<Vec3> targets = opt.L1Step(s, cells, true, &misfit);
+      std::vector<Vec3> targets;
+      bool move = step < most;
+      if (move && around_index) {
+        const double reach = kSettleReach * opt.MeanSpacing(s.position);
+        movers.assign(s.position.size(), 0);
+        for (size_t i = 0; i < s.position.size(); ++i) {
+          around_index->WithinRadius(s.position[i], reach, near);
+          movers[i] = !near.empty();
+        }
+      }
+      if (move) targets = opt.L1Step(s, cells, true, &misfit, around_index ? &movers : nullptr);
+      if (move && step >= steps) {
+        const double settled = kFeatureSettledMove * opt.MeanSpacing(s.position);
+        move = false;
+        for (size_t i = 0; i < targets.size() && !move; ++i) move = (targets[i] - s.position[i]).norm() > settled;
+      }
+      if (!move) {
+        // The ranks at the final positions; then the seeds crowding a higher-ranked feature seed there.
+        if (options.feature_clearance > 0.0) crowded += opt.DropCrowded(s, cells);
+        return crowded;
+      }
       // Seeds whose steps meet are thinned before the move (the better fitting target stays): otherwise two
       // corner seeds both step onto one corner, Project undoes both moves as too near, and neither reaches it.
       if (options.feature_clearance > 0.0) {
@@ -783,12 +838,8 @@ SeedCloud OptimizeSeeds(const Udf& udf, const SeedCloud& input, const OptimizeSe
       const std::vector<Vec3> before = s.position;
       opt.Project(s, before, std::move(targets), 0.25 * opt.MeanSpacing(s.position));
     }
-    // The ranks at the final positions; then the seeds crowding a higher-ranked feature seed there.
-    const CellSamples final_cells = opt.Analyze(s);
-    if (options.feature_clearance > 0.0) crowded += opt.DropCrowded(s, final_cells);
-    return crowded;
   };
-  size_t crowded = settle_features();
+  size_t crowded = settle_features(nullptr);
   const auto [spacing_out, cv_out] = opt.SpacingStats(s.position);
   if (crowded > 0)
     monitor.Info(std::to_string(crowded) + Format(" seeds dropped by the feature-seed thinning (nearer than %.2f x the "
@@ -799,7 +850,8 @@ SeedCloud OptimizeSeeds(const Udf& udf, const SeedCloud& input, const OptimizeSe
   if (chains) {
     const ChainFill fill = fill_chains(kFeatureChainRounds, false);
     if (fill.added > 0) {
-      const size_t settled = settle_features();
+      const std::vector<Vec3> added(s.position.end() - static_cast<long>(fill.added), s.position.end());
+      const size_t settled = settle_features(&added);
       monitor.Info(std::to_string(fill.added) + " seeds added on feature chains (" +
                    (options.feature_gap_max > 0.0 ? (options.feature_chord_tol > 0.0 ? "gaps, ends, bends" : "gaps, ends")
                                                   : "bends") +
