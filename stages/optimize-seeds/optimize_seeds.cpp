@@ -370,13 +370,14 @@ class Optimizer {
         if (static_cast<size_t>(b) < fresh) continue;
         const Vec3 &pa = s.position[static_cast<size_t>(a)], &pb = s.position[static_cast<size_t>(b)];
         const double h = (pb - pa).norm();
-        if (h < 2.5 * clearance || (bend_tol <= 0.0 && !(max_gap > 0.0 && h > max_gap))) continue;
+        const bool gap = max_gap > 0.0 && h > max_gap;
+        if (h < 2.5 * clearance || (bend_tol <= 0.0 && !gap)) continue;
         // A gap between a corner and a curve seed is split kCornerGapSplit spacings from the corner (its
         // midpoint when that is farther), so that the added seed clears the corner rule below and both
         // pieces of a gap up to 2 spacings are at most 1.5 spacings long.
         Vec3 start = 0.5 * (pa + pb);
         const bool a_corner = s.rank[static_cast<size_t>(a)].rank == 3, b_corner = s.rank[static_cast<size_t>(b)].rank == 3;
-        if (max_gap > 0.0 && h > max_gap && a_corner != b_corner) {
+        if (gap && a_corner != b_corner) {
           const Vec3 &corner = a_corner ? pa : pb, &other = a_corner ? pb : pa;
           const double from_corner = std::min(std::max(0.5 * h, kCornerGapSplit * spacing), 0.7 * h);
           start = corner + (from_corner / h) * (other - corner);
