@@ -828,6 +828,10 @@ TEST(OptimizeSeeds, FeatureChordsFollowACurvedFeatureWithinTheTolerance) {
   auto chain = [&](const SeedCloud& in, double chord_tol) {
     OptimizeSeedsOptions options;
     options.feature_chord_tol = chord_tol;
+    // The bend rule alone: with the gap rule and the across step a 200-seed equator's chains are filled by
+    // both rules at once, and which chords stay long depends on which fills first.
+    options.feature_gap_max = 0.0;
+    options.l1_curve_step = "free";
     const SeedCloud out = OptimizeSeeds(*udf, in, options, Monitor::Null());
     Chain c;
     c.seeds = out.size();
@@ -861,15 +865,16 @@ TEST(OptimizeSeeds, FeatureChordsFollowACurvedFeatureWithinTheTolerance) {
   EXPECT_GE(within, 2);
 }
 
-// Feature chains (--feature-gap-max 1.5): along every edge of the cube, from corner to corner, no
-// two consecutive feature seeds are farther apart than 1.5 mean spacings (5 % slack: the spacing is the
-// one before seeds were added). Without the rule some chains have longer gaps (1.52–1.67 spacings at 1,000
-// seeds, draws 1–3), so the test can fail.
+// Feature chains (--feature-gap-max 1.5, the default): along every edge of the cube, from corner to corner,
+// no two consecutive feature seeds are farther apart than 1.5 mean spacings (5 % slack: the spacing is the
+// one before seeds were added). Without the rule, with the paper's L1 step, some chains have longer gaps
+// (1.52–1.67 spacings at 1,000 seeds, draws 1–3), so the test can fail.
 TEST(OptimizeSeeds, FeatureChainsHaveNoGapLongerThanTheLimit) {
   const auto cube = MakeShape("cube");
   auto largest_gap = [&](const SeedCloud& in, double gap_max) {
     OptimizeSeedsOptions options;
     options.feature_gap_max = gap_max;
+    if (gap_max == 0.0) options.l1_curve_step = "free";
     const SeedCloud out = OptimizeSeeds(*cube, in, options, Monitor::Null());
     double spacing = 0.0;
     NearestNeighbourCv(out.position, &spacing);
@@ -1023,12 +1028,13 @@ TEST_F(OptimizeSeedsExe, WritesSeedsOnTheSurfaceWithRanksAndATrace) {
   EXPECT_TRUE(r.out.empty());
   EXPECT_NE(r.err.find("outer 1:"), std::string::npos) << r.err;
   const SeedCloud seeds = ReadSeeds(out);
-  // A few seeds crowding the curves and the point where the three curves meet are dropped, and said so.
-  EXPECT_GE(seeds.size(), 265u);  // 268-279 measured over --seed 2-5 of sample-seeds, both --cell-samples
-  EXPECT_LE(seeds.size(), 300u);
-  if (seeds.size() < 300u) {
-    EXPECT_NE(r.err.find(std::to_string(300 - seeds.size()) + " seeds dropped"), std::string::npos) << r.err;
-  }
+  // Seeds crowding the curves and the point where the three curves meet are dropped, and said so; the
+  // feature chains add a few where a curve's chain has a gap (309 at --seed 2 of sample-seeds).
+  EXPECT_GE(seeds.size(), 265u);
+  EXPECT_LE(seeds.size(), 330u);
+  // The count is 300 less the seeds dropped and plus those added, each said (the fills inside the outer loop
+  // at debug level): the thinning drops some here whatever the fills add.
+  EXPECT_NE(r.err.find(" seeds dropped by the feature-seed thinning"), std::string::npos) << r.err;
   const auto udf = MakeShape("three-discs");
   size_t ranked = 0;
   for (size_t i = 0; i < seeds.size(); ++i) {
@@ -1036,8 +1042,10 @@ TEST_F(OptimizeSeedsExe, WritesSeedsOnTheSurfaceWithRanksAndATrace) {
     ranked += seeds.rank[i] >= 1;
   }
   EXPECT_EQ(ranked, seeds.size());
-  for (const char* name : {"iter-001.ply", "iter-002.ply", "iter-003.ply"})
-    EXPECT_EQ(ReadSeeds(dir_ / ("trace/" + std::string(name))).size(), 300u) << name;
+  // Outer iteration 1 keeps every seed; the chains are filled before iterations 2 and 3.
+  EXPECT_EQ(ReadSeeds(dir_ / "trace/iter-001.ply").size(), 300u);
+  for (const char* name : {"iter-002.ply", "iter-003.ply"})
+    EXPECT_GE(ReadSeeds(dir_ / ("trace/" + std::string(name))).size(), 300u) << name;
   EXPECT_NE(test::ReadBytes(out).find("comment stage optimize-seeds"), std::string::npos);
   // --trace is debugging output: not in the provenance, and the output is the same bytes without it.
   EXPECT_EQ(test::ReadBytes(out).find("--trace"), std::string::npos);

@@ -62,16 +62,16 @@ struct OptimizeSeedsOptions {
   double feature_chord_tol = 0.0;
   /// Where two consecutive seeds of a feature chain lie farther apart than this × the mean spacing, a seed
   /// is added on the curve between them, and a chain's end is extended one spacing along its curve while
-  /// the L1 step finds the curve there (--feature-gap-max; 0: never, the default; 1–2.5, the chain search
-  /// radius). Not in the paper, see docs/optimize-seeds.md ("Feature chains", also for why it is off).
-  double feature_gap_max = 0.0;
+  /// the L1 step finds the curve there (--feature-gap-max; 0: never; 1–2.5, the chain search radius).
+  /// Not in the paper, see docs/optimize-seeds.md ("Feature chains").
+  double feature_gap_max = 1.5;
   double max_step = 0.5;          ///< trust region: a repulsion round moves a seed at most this many σ (--max-step)
   double repulsion_cutoff = 3.0;  ///< neighbours interact within this many σ (kernel 1.1e-2 at 3σ) (--repulsion-cutoff)
   /// --l1-curve-step: how the L1 step moves a curve seed (rank 2). "free": in every direction (the paper);
-  /// "across": only across its curve unless its cell sees a third plane (StepAcrossCurve); "auto" (default):
+  /// "across" (default): only across its curve unless its cell sees a third plane (StepAcrossCurve); "auto":
   /// across on a field with a floor (value errors: the projection measured a twin width), free on an exact
   /// field. Not in the paper, see docs/optimize-seeds.md ("Curve seeds step across their curve").
-  std::string l1_curve_step = "auto";
+  std::string l1_curve_step = "across";
   double l1_tol_rel = 1e-6;       ///< L1 step solved to this position accuracy, relative to the diagonal (--l1-tol-rel)
   int l1_max_steps = 200;         ///< Newton steps of the L1 step's barrier method before it gives up (--l1-max-steps)
   double move_tol = 1e-3;         ///< an inner loop moving no seed farther than move_tol·σ "makes no update" (--move-tol)
