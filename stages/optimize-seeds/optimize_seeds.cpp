@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <memory>
 #include <numeric>
 
@@ -88,6 +89,12 @@ constexpr double kFeatureSettledMove = 0.05;
 constexpr double kSettleReach = 2.0;
 // SeesTwoPlanes' contrast: between a uniform spread's 3.46 (one curved sheet) and the > 9 of two planes.
 constexpr double kCreaseContrast = 6.0;
+// A chain fill leaves at most this share more seeds than the input count (or the count before the fill, if
+// more), so --count stays the output size within a few percent: the fills before outer iterations give
+// back crowded sheet seeds, and where there are too few (most seeds ranked as features: feature-dense
+// parts, or gradient errors of 30° that make the rank test take sheets for curves) the last added go; the
+// last fill, which gives back none, stops there.
+constexpr double kChainCountSlack = 0.02;
 
 class Optimizer {
  public:
@@ -346,11 +353,13 @@ class Optimizer {
   // feature and is not crowded by one: for a chord, on a curve (rank 2, tangent along the chord) between 1/4
   // and 3/4 of it, off it by at most a quarter chord (a bend, not a jump to another feature) and, unless the
   // chord is a gap, by more than `bend_tol`; for an end, 0.5–1.6 spacings ahead on a curve running that way,
-  // or on a corner (rank 3). Invariant after a round that adds nothing: every chord of at least 2.5
+  // or on a corner (rank 3); and only while there are fewer than `max_count` seeds (trials in a fixed order).
+  // Invariant after a round that adds nothing, unless `max_count` stopped it: every chord of at least 2.5
   // clearances is at most `max_gap` long and has its midpoint within `bend_tol` of its curve, and one
   // spacing beyond every chain end there is no further curve for the L1 step to find. Sheet seeds nearer
   // than `clearance` to an added seed are dropped, as the feature-seed thinning does. Returns the count added.
-  size_t RefineFeatureChains(SeedState& s, double bend_tol, double max_gap, double clearance, int rounds) {
+  size_t RefineFeatureChains(SeedState& s, double bend_tol, double max_gap, double clearance, int rounds,
+                             size_t max_count) {
     const size_t n0 = s.position.size();
     size_t added = 0, last_added = 0;
     const double spacing = MeanSpacing(s.position);
@@ -454,7 +463,7 @@ class Optimizer {
         }
         for (size_t k = n; k < s.position.size() && !crowded; ++k)
           crowded = (s.position[k] - landed[t]).norm() < crowd_radius;
-        if (crowded) continue;
+        if (crowded || s.position.size() >= max_count) continue;
         s.position.push_back(landed[t]);
         s.udf.push_back(r.distance[t]);
         s.normal.push_back(r.gradient[t]);
@@ -685,10 +694,23 @@ SeedCloud OptimizeSeeds(const Udf& udf, const SeedCloud& input, const OptimizeSe
     ChainFill fill;
     const double spacing = opt.MeanSpacing(s.position);
     const size_t before = s.position.size();
+    const size_t most = std::max(before, static_cast<size_t>((1.0 + kChainCountSlack) * static_cast<double>(n)));
     fill.added = opt.RefineFeatureChains(s, options.feature_chord_tol * spacing, options.feature_gap_max * spacing,
-                                         options.feature_clearance * spacing, rounds);
+                                         options.feature_clearance * spacing, rounds,
+                                         keep_count ? std::numeric_limits<size_t>::max() : most);
     if (fill.added == 0) return fill;
     if (keep_count && s.position.size() > before) DropCrowdedSheetSeeds(s, s.position.size() - before);
+    if (s.position.size() > most) {
+      // Too few sheet seeds to give back (most seeds ranked as features): the last seeds added go again.
+      // Dropped seeds keep their order, so the seeds added are still the last ones.
+      const size_t excess = s.position.size() - most;
+      fill.added -= excess;
+      s.position.resize(most);
+      s.udf.resize(most);
+      s.normal.resize(most);
+      s.rank.resize(most);
+      s.space.resize(most);
+    }
     fill.dropped = before + fill.added - s.position.size();
     opt.Analyze(s);
     return fill;
