@@ -728,13 +728,10 @@ SeedCloud OptimizeSeeds(const Udf& udf, const SeedCloud& input, const OptimizeSe
     if (s.position.size() > most) {
       // Too few sheet seeds to give back (most seeds ranked as features): the last seeds added go again.
       // Dropped seeds keep their order, so the seeds added are still the last ones.
-      const size_t excess = s.position.size() - most;
-      fill.added -= excess;
-      s.position.resize(most);
-      s.udf.resize(most);
-      s.normal.resize(most);
-      s.rank.resize(most);
-      s.space.resize(most);
+      std::vector<char> drop(s.position.size(), 0);
+      std::fill(drop.begin() + static_cast<long>(most), drop.end(), 1);
+      fill.added -= s.position.size() - most;
+      EraseSeeds(s, drop);
     }
     fill.dropped = before + fill.added - s.position.size();
     opt.Analyze(s);
