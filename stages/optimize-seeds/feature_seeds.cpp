@@ -208,4 +208,72 @@ std::vector<char> SeedsBesideFeatures(const std::vector<Vec3>& position, const s
   return drop;
 }
 
+namespace {
+// Where a gap between a corner and a curve seed is split, in spacings from the corner: beyond the one
+// spacing within which no curve seed is added, with room for the L1 step's move onto the curve.
+constexpr double kCornerGapSplit = 1.05;
+}  // namespace
+
+std::vector<ChainTrial> ChainTrials(const SeedState& s, const FeatureLinks& links, size_t fresh, double bend_tol,
+                                    double max_gap, double clearance, double spacing) {
+  std::vector<ChainTrial> trials;
+  for (const auto& [a, b] : links.chords) {
+    if (static_cast<size_t>(b) < fresh) continue;
+    const Vec3 &pa = s.position[static_cast<size_t>(a)], &pb = s.position[static_cast<size_t>(b)];
+    const double h = (pb - pa).norm();
+    const bool gap = max_gap > 0.0 && h > max_gap;
+    if (h < 2.5 * clearance || (bend_tol <= 0.0 && !gap)) continue;
+    // A gap between a corner and a curve seed is split kCornerGapSplit spacings from the corner (its
+    // midpoint when that is farther), so that the added seed clears the corner rule of Crowded and both
+    // pieces of a gap up to 2 spacings are at most 1.5 spacings long.
+    Vec3 start = 0.5 * (pa + pb);
+    const bool a_corner = s.rank[static_cast<size_t>(a)].rank == 3, b_corner = s.rank[static_cast<size_t>(b)].rank == 3;
+    if (gap && a_corner != b_corner) {
+      const Vec3 &corner = a_corner ? pa : pb, &other = a_corner ? pb : pa;
+      const double from_corner = std::min(std::max(0.5 * h, kCornerGapSplit * spacing), 0.7 * h);
+      start = corner + (from_corner / h) * (other - corner);
+    }
+    trials.push_back({a, b, start, Vec3::Zero()});
+  }
+  if (max_gap > 0.0)
+    for (const auto& [a, direction] : links.ends)
+      if (static_cast<size_t>(a) >= fresh)
+        trials.push_back({a, -1, s.position[static_cast<size_t>(a)] + spacing * direction, direction});
+  return trials;
+}
+
+double LandedOnItsFeature(const SeedState& s, const ChainTrial& c, const Vec3& landed, int rank, const Vec3& t_new,
+                          double bend_tol, double max_gap, double spacing) {
+  const Vec3& pa = s.position[static_cast<size_t>(c.a)];
+  if (c.b >= 0) {
+    const Vec3& pb = s.position[static_cast<size_t>(c.b)];
+    const double h = (pb - pa).norm(), u = (landed - pa).dot(pb - pa) / (h * h);
+    const double off = (landed - c.start).norm();
+    const bool gap = max_gap > 0.0 && h > max_gap;
+    if (rank != 2 || u < 0.25 || u > 0.75 || off > 0.25 * h || (!gap && off <= bend_tol) ||
+        std::abs(t_new.dot(pb - pa)) < 0.8 * h)
+      return -1.0;
+    return 0.2 * h;
+  }
+  const Vec3 e = landed - pa;
+  const double ahead = e.dot(c.direction);
+  if (ahead < 0.5 * spacing || ahead > 1.6 * spacing || ahead < 0.8 * e.norm()) return -1.0;
+  if (rank == 2 && std::abs(t_new.dot(e)) < 0.8 * e.norm()) return -1.0;
+  return 0.5 * spacing;
+}
+
+bool Crowded(const SeedState& s, size_t n, const SeedIndex& index, const Vec3& landed, int rank, double crowd_radius,
+             double spacing) {
+  std::vector<int> near;
+  index.WithinRadius(landed, std::max(crowd_radius, spacing), near);
+  for (int j : near) {
+    const int rank_j = s.rank[static_cast<size_t>(j)].rank;
+    const double d = (s.position[static_cast<size_t>(j)] - landed).norm();
+    if ((rank_j >= 2 && d < crowd_radius) || (rank_j == 3 && rank == 2)) return true;
+  }
+  for (size_t k = n; k < s.position.size(); ++k)
+    if ((s.position[k] - landed).norm() < crowd_radius) return true;
+  return false;
+}
+
 }  // namespace voroudf

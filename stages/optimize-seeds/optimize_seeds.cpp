@@ -77,9 +77,6 @@ std::string Format(const char* format, double a = 0, double b = 0, double c = 0,
 constexpr int kFeatureChainRounds = 6;
 // ... before each outer iteration after the first, which moves the seeds anyway.
 constexpr int kFeatureChainRoundsInLoop = 2;
-// Where a gap between a corner and a curve seed is split, in spacings from the corner: beyond the one
-// spacing within which no curve seed is added, with room for the L1 step's move onto the curve.
-constexpr double kCornerGapSplit = 1.05;
 // Feature steps after the --feature-steps ones, taken while a feature seed's step would still move it more
 // than kFeatureSettledMove mean spacings (a seed ranked as a feature only after its neighbours stepped).
 constexpr int kFeatureExtraSteps = 2;
@@ -95,89 +92,6 @@ constexpr double kCreaseContrast = 6.0;
 // parts, or gradient errors of 30° that make the rank test take sheets for curves) the last added go; the
 // last fill, which gives back none, stops there.
 constexpr double kChainCountSlack = 0.02;
-
-// A trial seed of RefineFeatureChains: from a chord (a, b) or from one spacing beyond a chain's end at a.
-struct ChainTrial {
-  int a = -1, b = -1;  // a chord's ends, or (a, -1): a chain end at seed a
-  Vec3 start = Vec3::Zero(), direction = Vec3::Zero();
-};
-
-// The trials of one round of RefineFeatureChains over the links with a seed from `fresh` on: the midpoints
-// of the chords that are gaps (longer than max_gap) or, with bend_tol > 0, of every chord of at least 2.5
-// clearances; and one spacing beyond every chain end (with max_gap > 0).
-std::vector<ChainTrial> ChainTrials(const SeedState& s, const FeatureLinks& links, size_t fresh, double bend_tol,
-                                    double max_gap, double clearance, double spacing) {
-  std::vector<ChainTrial> trials;
-  for (const auto& [a, b] : links.chords) {
-    if (static_cast<size_t>(b) < fresh) continue;
-    const Vec3 &pa = s.position[static_cast<size_t>(a)], &pb = s.position[static_cast<size_t>(b)];
-    const double h = (pb - pa).norm();
-    const bool gap = max_gap > 0.0 && h > max_gap;
-    if (h < 2.5 * clearance || (bend_tol <= 0.0 && !gap)) continue;
-    // A gap between a corner and a curve seed is split kCornerGapSplit spacings from the corner (its
-    // midpoint when that is farther), so that the added seed clears the corner rule of Crowded and both
-    // pieces of a gap up to 2 spacings are at most 1.5 spacings long.
-    Vec3 start = 0.5 * (pa + pb);
-    const bool a_corner = s.rank[static_cast<size_t>(a)].rank == 3, b_corner = s.rank[static_cast<size_t>(b)].rank == 3;
-    if (gap && a_corner != b_corner) {
-      const Vec3 &corner = a_corner ? pa : pb, &other = a_corner ? pb : pa;
-      const double from_corner = std::min(std::max(0.5 * h, kCornerGapSplit * spacing), 0.7 * h);
-      start = corner + (from_corner / h) * (other - corner);
-    }
-    trials.push_back({a, b, start, Vec3::Zero()});
-  }
-  if (max_gap > 0.0)
-    for (const auto& [a, direction] : links.ends)
-      if (static_cast<size_t>(a) >= fresh)
-        trials.push_back({a, -1, s.position[static_cast<size_t>(a)] + spacing * direction, direction});
-  return trials;
-}
-
-// Whether a trial that landed at `landed`, in a cell of rank `rank` with curve tangent t_new, found the
-// feature it was sent to: for a chord, on a curve along it between 1/4 and 3/4 of it, at most a quarter
-// chord from its start and, unless the chord is a gap, more than bend_tol from it; for an end, 0.5–1.6
-// spacings ahead on a curve running that way or on a corner. Returns the radius within which no feature
-// seed may lie (0.2 chords, 0.5 spacings), or -1 where the trial missed.
-double LandedOnItsFeature(const SeedState& s, const ChainTrial& c, const Vec3& landed, int rank, const Vec3& t_new,
-                          double bend_tol, double max_gap, double spacing) {
-  const Vec3& pa = s.position[static_cast<size_t>(c.a)];
-  if (c.b >= 0) {
-    const Vec3& pb = s.position[static_cast<size_t>(c.b)];
-    const double h = (pb - pa).norm(), u = (landed - pa).dot(pb - pa) / (h * h);
-    const double off = (landed - c.start).norm();
-    const bool gap = max_gap > 0.0 && h > max_gap;
-    if (rank != 2 || u < 0.25 || u > 0.75 || off > 0.25 * h || (!gap && off <= bend_tol) ||
-        std::abs(t_new.dot(pb - pa)) < 0.8 * h)
-      return -1.0;
-    return 0.2 * h;
-  }
-  const Vec3 e = landed - pa;
-  const double ahead = e.dot(c.direction);
-  if (ahead < 0.5 * spacing || ahead > 1.6 * spacing || ahead < 0.8 * e.norm()) return -1.0;
-  if (rank == 2 && std::abs(t_new.dot(e)) < 0.8 * e.norm()) return -1.0;
-  return 0.5 * spacing;
-}
-
-// Whether a landed trial seed is crowded: a feature seed of the n before the round (`index`), or a seed
-// added in this round (from n on: two ends facing each other), nearer than crowd_radius (at least the
-// clearance, so that the feature-seed thinning keeps every seed added); or, for a curve seed (rank 2), a
-// corner within a spacing: a cell that near sees the corner's planes, so the seed would be ranked 3 at the
-// next analysis and stepped onto the corner, crowding it, and the thinning may then keep the one beside the
-// corner (open corners of crossing-planes and three-discs: a non-manifold edge 0.004–0.01 off the curve,
-// and 0.3–0.5 off it at a rim's corner).
-bool Crowded(const SeedState& s, size_t n, const SeedIndex& index, const Vec3& landed, int rank, double crowd_radius,
-             double spacing) {
-  std::vector<int> near;
-  index.WithinRadius(landed, std::max(crowd_radius, spacing), near);
-  for (int j : near) {
-    const int rank_j = s.rank[static_cast<size_t>(j)].rank;
-    const double d = (s.position[static_cast<size_t>(j)] - landed).norm();
-    if ((rank_j >= 2 && d < crowd_radius) || (rank_j == 3 && rank == 2)) return true;
-  }
-  for (size_t k = n; k < s.position.size(); ++k)
-    if ((s.position[k] - landed).norm() < crowd_radius) return true;
-  return false;
-}
 
 class Optimizer {
  public:
