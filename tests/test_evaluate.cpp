@@ -9,6 +9,7 @@
 #include "common/errors.h"
 #include "common/rng.h"
 #include "formats/mesh_io.h"
+#include "stages/evaluate/crossings.h"
 #include "stages/evaluate/evaluate.h"
 #include "tests/support/test_support.h"
 
@@ -611,6 +612,88 @@ TEST(EvaluateNmcd, SamplesAreSpreadByLengthOverTheNonManifoldEdges) {
   EXPECT_EQ(on_tall, 750u);
   EXPECT_TRUE(SampleNonManifoldEdges(Square(2), 100, &length).empty());
   EXPECT_EQ(length, 0.0);
+}
+
+// ---- the reference's crossing curves ----
+
+// Both meshes' faces over both vertex sets, sharing no vertex: two parts modelled separately.
+TriangleMesh Parts(const TriangleMesh& a, const TriangleMesh& b) {
+  TriangleMesh m = a;
+  const int base = static_cast<int>(m.vertices.size());
+  m.vertices.insert(m.vertices.end(), b.vertices.begin(), b.vertices.end());
+  for (const Tri& t : b.faces) m.faces.push_back({base + t[0], base + t[1], base + t[2]});
+  return m;
+}
+
+// Square(n) turned by `deg` degrees about the line y = 0.5, z = 0 (the x direction), then shifted along z.
+TriangleMesh Turned(int n, double deg, double dz = 0.0) {
+  TriangleMesh m = Square(n);
+  const double c = std::cos(deg * M_PI / 180), s = std::sin(deg * M_PI / 180);
+  for (Vec3& p : m.vertices) p = Vec3(p.x(), 0.5 + c * (p.y() - 0.5), s * (p.y() - 0.5) + dz);
+  return m;
+}
+
+double Length(const CurveSegments& c) {
+  double l = 0;
+  for (const Edge& e : c.edges) l += (c.vertices[e[1]] - c.vertices[e[0]]).norm();
+  return l;
+}
+
+TEST(EvaluateCrossings, TwoPartsCrossingBranchAlongTheirLineAtAnyAngleAboveTheFeatureAngle) {
+  for (double deg : {35.0, 60.0, 90.0}) {
+    // 5 x 5 against 3 x 3 cells: the line y = 0.5 runs through the first's cells and along none of its edges.
+    const CurveSegments c = CrossingCurves(Parts(Square(5), Turned(3, deg)), 1e-7, 30.0);
+    EXPECT_NEAR(Length(c), 1.0, 1e-9) << deg;
+    for (const Vec3& p : c.vertices) {
+      EXPECT_NEAR(p.y(), 0.5, 1e-9);
+      EXPECT_NEAR(p.z(), 0.0, 1e-9);
+    }
+  }
+  // Below the feature angle the two are one sheet to a mesher; crossing parts that share the line's
+  // vertices (one welded mesh) have it as edges of 4 faces, which NonManifoldEdges reports instead.
+  EXPECT_TRUE(CrossingCurves(Parts(Square(5), Turned(3, 20.0)), 1e-7, 30.0).edges.empty());
+  EXPECT_TRUE(CrossingCurves(Book(4), 1e-7, 30.0).edges.empty());
+}
+
+TEST(EvaluateCrossings, AWallTouchingAFaceIsAJunctionASeamIsNot) {
+  // A wall standing on the square along y = 0.5 (its top edge on the square, not through it): 3 half-sheets.
+  // With 4 x 4 cells the line runs along the square's edges, with 5 x 5 through its cells.
+  const TriangleMesh wall = Turned(3, 90.0, -0.5);  // y = 0.5, z in [-1, 0]
+  for (int n : {4, 5}) EXPECT_NEAR(Length(CrossingCurves(Parts(Square(n), wall), 1e-7, 30.0)), 1.0, 1e-9) << n;
+  // Two squares meeting at the line with vertices of their own (an unwelded crease or seam): 2 half-sheets.
+  TriangleMesh half = Square(4);
+  for (Vec3& p : half.vertices) p = Vec3(p.x(), 0.5 + 0.5 * p.y(), 0.5 * p.y());  // from y = 0.5 up and back
+  TriangleMesh other = Square(3);
+  for (Vec3& p : other.vertices) p = Vec3(p.x(), 0.5 * p.y(), 0.0);  // y in [0, 0.5]
+  EXPECT_TRUE(CrossingCurves(Parts(other, half), 1e-7, 30.0).edges.empty());
+  // A closed mesh has no crossing at all.
+  EXPECT_TRUE(CrossingCurves(Cube(4), 1e-7, 30.0).edges.empty());
+  EXPECT_TRUE(CrossingCurves(Sphere(3), 1e-7, 30.0).edges.empty());
+}
+
+TEST(EvaluateCrossings, AMeshThatBranchesWhereTheReferencesPartsCrossIsNotSpurious) {
+  // The reference: two separate squares crossing at 90 degrees (no edge of 3+ faces). The mesh: the same
+  // surface as one welded mesh, whose crossing line is an edge of 4 faces.
+  const TriangleMesh ref = Parts(Square(5), Turned(3, 90.0));
+  TriangleMesh mesh = Book(4, Vec3(0, 0, 0));  // four pages around the spine x = y = 0, z in [0, 1]
+  for (Vec3& p : mesh.vertices) p = Vec3(p.z(), 0.5 + p.x(), p.y());  // spine along x at y = 0.5, z = 0
+  EvaluateOptions union_curves = Few();
+  const Metrics m = Eval(mesh, ref, union_curves);
+  EXPECT_EQ(m.mesh.topology.nonmanifold_edges, 1u);
+  EXPECT_EQ(m.spurious_nonmanifold_edges, 0u);
+  EXPECT_NEAR(m.ref_crossing_length, m.frame.scale, 1e-9);
+  EXPECT_LT(m.nmcd_x1e3, 0.1);  // both sample the same line, in other pieces: half a sample spacing at most
+  // DESIGN.md's definition (edges of 3+ faces only) sees no branching in the reference.
+  EvaluateOptions edges_only = Few();
+  edges_only.ref_nm_curves = "edges";
+  const Metrics e = Eval(mesh, ref, edges_only);
+  EXPECT_TRUE(std::isinf(e.nmcd_x1e3));
+  EXPECT_EQ(e.spurious_nonmanifold_edges, 1u);
+  EXPECT_EQ(e.ref_crossing_length, 0.0);
+  // A mesh branching elsewhere (farther than its median edge length, about 1 here): spurious either way.
+  TriangleMesh off = mesh;
+  for (Vec3& p : off.vertices) p += Vec3(0, 0, 3);
+  EXPECT_EQ(Eval(off, ref, union_curves).spurious_nonmanifold_edges, 1u);
 }
 
 // ---- errors, determinism, JSON ----

@@ -17,6 +17,7 @@
 #include "common/errors.h"
 #include "common/rng.h"
 #include "common/triangle_bvh.h"
+#include "stages/evaluate/crossings.h"
 
 namespace voroudf {
 namespace {
@@ -97,6 +98,8 @@ void EvaluateOptions::Check() const {
   if (empty_edge_points < 1) throw UsageError("the ECD stand-in needs at least one point");
   if (edge_samples < 1 || edge_samples > 100000000) throw UsageError("--edge-samples must be in [1, 1e8]");
   if (!(feature_angle_deg > 0 && feature_angle_deg < 180)) throw UsageError("--feature-angle must be in (0, 180)");
+  if (ref_nm_curves != "union" && ref_nm_curves != "edges")
+    throw UsageError("--ref-nm-curves must be union or edges, not '" + ref_nm_curves + "'");
 }
 
 Frame ReferenceFrame(const TriangleMesh& reference) {
@@ -502,8 +505,39 @@ Metrics Evaluate(const TriangleMesh& mesh_in, const TriangleMesh& reference_in, 
     m.ecd_x1e2 = Chamfer(ref_edge, mesh_edge, monitor).SumOfMeans() * 1e2;
   }
 
-  const std::vector<Vec3> ref_nm = SampleNonManifoldEdges(ref_welded, options.nm_samples, &m.ref.nonmanifold_length);
+  // The reference's non-manifold curves: its edges of 3+ faces, and with "union" where its triangles cross.
+  TriangleMesh ref_curves;
+  ref_curves.vertices = ref_welded.vertices;
+  std::vector<Edge> ref_curve_edges = NonManifoldEdges(ref_welded);
+  for (const Edge& e : ref_curve_edges)
+    m.ref.nonmanifold_length += (ref_welded.vertices[e[1]] - ref_welded.vertices[e[0]]).norm();
+  if (options.ref_nm_curves == "union") {
+    const CurveSegments crossing = CrossingCurves(ref_welded, options.weld_tolerance, options.feature_angle_deg);
+    const int base = static_cast<int>(ref_curves.vertices.size());
+    ref_curves.vertices.insert(ref_curves.vertices.end(), crossing.vertices.begin(), crossing.vertices.end());
+    for (const Edge& e : crossing.edges) {
+      ref_curve_edges.push_back({base + e[0], base + e[1]});
+      m.ref_crossing_length += (crossing.vertices[e[1]] - crossing.vertices[e[0]]).norm();
+    }
+    if (!crossing.edges.empty())
+      monitor.Info("reference: " + std::to_string(crossing.edges.size()) +
+                   Fmt(" crossing segments of length %.6g where its triangles cross or touch (non-manifold in the "
+                       "UDF)", m.ref_crossing_length));
+  }
+  const std::vector<Vec3> ref_nm = SampleEdges(ref_curves, ref_curve_edges, options.nm_samples, nullptr);
   const std::vector<Vec3> mesh_nm = SampleNonManifoldEdges(mesh_welded, options.nm_samples, &m.mesh.nonmanifold_length);
+  {
+    const std::vector<Edge> mesh_nm_edges = NonManifoldEdges(mesh_welded);
+    std::vector<Vec3> mid;
+    for (const Edge& e : mesh_nm_edges) mid.push_back(0.5 * (mesh_welded.vertices[e[0]] + mesh_welded.vertices[e[1]]));
+    if (ref_curve_edges.empty() || mid.empty()) {
+      m.spurious_nonmanifold_edges = mid.size();
+    } else {
+      const double far = MedianEdgeLength(mesh_welded);
+      for (double d : DistancesToSegments(mid, ref_curves.vertices, ref_curve_edges, monitor))
+        m.spurious_nonmanifold_edges += d > far;
+    }
+  }
   if (ref_nm.empty() && mesh_nm.empty()) {
     m.nmcd_x1e3 = 0.0;
   } else if (ref_nm.empty() || mesh_nm.empty()) {
@@ -554,6 +588,7 @@ std::string MetricsJson(const Metrics& m, const EvaluateOptions& options, const 
   num("tq", m.mesh.tq);
   count("td", m.td);
   num("nmcd_x1e3", m.nmcd_x1e3);
+  count("spurious_nonmanifold_edges", static_cast<long long>(m.spurious_nonmanifold_edges));
   num("cd_exact_x1e3", m.exact.cd_x1e3);
   num("hd_exact_x1e3", m.exact.hd_x1e3);
   num("p99_exact_x1e3", m.exact.p99_x1e3);
@@ -592,6 +627,7 @@ std::string MetricsJson(const Metrics& m, const EvaluateOptions& options, const 
   count("ref_faces", static_cast<long long>(m.ref.faces));
   num("ref_tq", m.ref.tq);
   report("ref_", m.ref);
+  num("ref_crossing_length", m.ref_crossing_length);
   if (seconds >= 0) num("seconds", seconds);
   return out + "}\n";
 }

@@ -25,6 +25,10 @@ struct EvaluateOptions {
   size_t edge_samples = 10000;   ///< exact ECD: samples per mesh along its sharp edges, by length (--edge-samples)
   bool floor = false;            ///< also the sampled metrics of the reference against itself (--floor)
   double feature_angle_deg = 30.0;  ///< feature recall: an edge whose dihedral departs from flat by more (--feature-angle)
+  /// The reference's non-manifold curves (--ref-nm-curves): "union", its edges of 3+ faces and the curves where
+  /// its triangles cross or touch (CrossingCurves: the UDF is the distance to their union); "edges", the
+  /// edges of 3+ faces alone (DESIGN.md's definition).
+  std::string ref_nm_curves = "union";
 
   /// Throws UsageError for values that cannot work.
   void Check() const;
@@ -161,6 +165,10 @@ struct Metrics {
   double hd_x1e3 = 0;    ///< max one-sided Hausdorff / reference bbox diagonal, x1e3
   double ecd_x1e2 = 0;   ///< edge Chamfer (sum of means) x1e2
   double nmcd_x1e3 = 0;  ///< non-manifold Chamfer (sum of means) x1e3; +infinity if only one side has such edges
+  double ref_crossing_length = 0;  ///< length of the reference's crossing curves (CrossingCurves), in the frame
+  /// The mesh's non-manifold edges whose midpoint lies farther than the mesh's median edge length from every
+  /// non-manifold curve of the reference: branching the reference does not have.
+  size_t spurious_nonmanifold_edges = 0;
   long long td = 0;      ///< |chi(mesh) - chi(ref)|
   ExactMetrics exact;
   FeatureMetrics features;

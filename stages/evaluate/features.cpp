@@ -24,17 +24,6 @@ bool Runs(const Tri& t, int a, int b) {
   return false;
 }
 
-double MedianEdgeLength(const TriangleMesh& m) {
-  const EdgeFaces ef = BuildEdgeFaces(m.faces);
-  std::vector<double> len;
-  len.reserve(ef.edges.size());
-  for (const Edge& e : ef.edges)
-    len.push_back((m.vertices[static_cast<size_t>(e[1])] - m.vertices[static_cast<size_t>(e[0])]).norm());
-  if (len.empty()) return 0.0;
-  std::nth_element(len.begin(), len.begin() + static_cast<long>(len.size() / 2), len.end());
-  return len[len.size() / 2];
-}
-
 std::vector<Edge> AllEdges(const TriangleMesh& m) { return BuildEdgeFaces(m.faces).edges; }
 
 // Share of the samples of `edges` (by length) within `tol` of `targets`, and their mean and largest distance.
@@ -69,6 +58,17 @@ Coverage Cover(const TriangleMesh& from, const std::vector<Edge>& edges, const T
 }
 
 }  // namespace
+
+double MedianEdgeLength(const TriangleMesh& m) {
+  const EdgeFaces ef = BuildEdgeFaces(m.faces);
+  std::vector<double> len;
+  len.reserve(ef.edges.size());
+  for (const Edge& e : ef.edges)
+    len.push_back((m.vertices[static_cast<size_t>(e[1])] - m.vertices[static_cast<size_t>(e[0])]).norm());
+  if (len.empty()) return 0.0;
+  std::nth_element(len.begin(), len.begin() + static_cast<long>(len.size() / 2), len.end());
+  return len[len.size() / 2];
+}
 
 std::vector<Edge> FeatureEdges(const TriangleMesh& mesh, double min_angle_deg) {
   const EdgeFaces ef = BuildEdgeFaces(mesh.faces);

@@ -16,6 +16,9 @@ namespace voroudf {
 /// In BuildEdgeFaces order.
 std::vector<Edge> FeatureEdges(const TriangleMesh& mesh, double min_angle_deg);
 
+/// The median length of the mesh's edges (each edge once); 0 without edges.
+double MedianEdgeLength(const TriangleMesh& mesh);
+
 /// Edges with exactly one face, in BuildEdgeFaces order.
 std::vector<Edge> BoundaryEdges(const TriangleMesh& mesh);
 

@@ -30,6 +30,10 @@ int main(int argc, char** argv) {
   app.add_option("--edge-samples", options.edge_samples, "samples per mesh along its sharp edges (exact ECD)");
   app.add_option("--feature-angle", options.feature_angle_deg,
                  "feature recall: edges whose dihedral departs from flat by more than this (degrees)");
+  app.add_option("--ref-nm-curves", options.ref_nm_curves,
+                 "the reference's non-manifold curves for NM-CD and spurious_nonmanifold_edges: union (its edges "
+                 "of 3+ faces and where its triangles cross or touch: the UDF's branching) or edges (3+ faces only)")
+      ->capture_default_str();
   app.add_flag("--floor", options.floor,
                "also the sampled CD/HD/ECD of the reference against itself (keys *_floor_*): their sampling floor");
   // Off by default: wall-clock time would make the output bytes differ from run to run.

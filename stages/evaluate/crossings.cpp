@@ -1,0 +1,217 @@
+#include "stages/evaluate/crossings.h"
+
+#include <CGAL/box_intersection_d.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <unordered_map>
+#include <utility>
+
+namespace voroudf {
+namespace {
+
+using FaceBox = CGAL::Box_intersection_d::Box_with_info_d<double, 3, int>;
+
+
+// The interval [t0, t1] of the line o + t dir (in the plane of triangle a, b, c with unit normal n) that
+// lies in the triangle, within `tolerance`; false if none.
+bool ClipLine(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& n, const Vec3& o, const Vec3& dir,
+              double tolerance, double* t0, double* t1) {
+  const std::array<Vec3, 3> corner{a, b, c};
+  for (int k = 0; k < 3; ++k) {
+    const Vec3& p = corner[static_cast<size_t>(k)];
+    const Vec3 inward = n.cross(corner[static_cast<size_t>((k + 1) % 3)] - p).normalized();
+    const double slope = dir.dot(inward), offset = (o - p).dot(inward) + tolerance;  // slope t + offset >= 0
+    if (std::abs(slope) < 1e-12) {
+      if (offset < 0) return false;
+    } else if (slope > 0) {
+      *t0 = std::max(*t0, -offset / slope);
+    } else {
+      *t1 = std::min(*t1, -offset / slope);
+    }
+  }
+  return *t0 <= *t1;
+}
+
+// The segment where triangles f and g meet, when their planes cross: the line of the two planes clipped to
+// both triangles (Moller 1997). Computed in doubles with a tolerance, by hand: CGAL's Triangle_3
+// intersection with inexact constructions can build a non-finite point on nearly parallel triangles and
+// then fail inside its own predicates, and with exact constructions it is too slow for the pairs of
+// neighbouring triangles that every mesh has.
+bool MeetingSegment(const TriangleMesh& mesh, const Tri& f, const Tri& g, double tolerance, double min_sine, Vec3* p,
+                    Vec3* q) {
+  const Vec3 &a0 = mesh.vertices[static_cast<size_t>(f[0])], &a1 = mesh.vertices[static_cast<size_t>(f[1])],
+             &a2 = mesh.vertices[static_cast<size_t>(f[2])];
+  const Vec3 &b0 = mesh.vertices[static_cast<size_t>(g[0])], &b1 = mesh.vertices[static_cast<size_t>(g[1])],
+             &b2 = mesh.vertices[static_cast<size_t>(g[2])];
+  const Vec3 ca = (a1 - a0).cross(a2 - a0), cb = (b1 - b0).cross(b2 - b0);
+  if (!(ca.norm() > 0 && cb.norm() > 0)) return false;  // degenerate
+  const Vec3 na = ca.normalized(), nb = cb.normalized();
+  const Vec3 cross = na.cross(nb);
+  if (!(cross.norm() > min_sine)) return false;  // within the angle: one sheet, no curve
+  const double da = na.dot(a0), db = nb.dot(b0);
+  const Vec3 o = (da * nb.cross(cross) + db * cross.cross(na)) / cross.squaredNorm();  // on both planes
+  const Vec3 dir = cross.normalized();
+  double t0 = -std::numeric_limits<double>::infinity(), t1 = std::numeric_limits<double>::infinity();
+  // Clipped without the tolerance: with it, two triangles that share a corner would meet along a sliver of
+  // tolerance / sin(angle) there. A piece shorter than 10 tolerances is a point.
+  constexpr double kClipSlack = 1e-12;
+  if (!ClipLine(a0, a1, a2, na, o, dir, kClipSlack, &t0, &t1) || !ClipLine(b0, b1, b2, nb, o, dir, kClipSlack, &t0, &t1))
+    return false;
+  if (!(t1 - t0 > 10 * tolerance)) return false;
+  *p = o + t0 * dir;
+  *q = o + t1 * dir;
+  return true;
+}
+
+int SharedVertices(const Tri& a, const Tri& b) {
+  int n = 0;
+  for (int u : a)
+    for (int v : b) n += u == v;
+  return n;
+}
+
+// The directions (unit, normal to `line`) in which triangle `t` leaves the line through m: of the two
+// directions across the line in its plane, those that point into the triangle from m (into its tangent
+// cone there: inwards from every edge m lies on). Two where m is inside it, one where m is on an edge
+// (along the line: the side the triangle is on; across it: the triangle's side of the line, its neighbour
+// over that edge having the other), none where its plane does not hold the line or m is off it.
+void HalfSheets(const TriangleMesh& mesh, const Tri& t, const Vec3& m, const Vec3& line, double tolerance,
+                std::vector<Vec3>* out) {
+  constexpr double kParallel = 1e-6;
+  const Vec3 &a = mesh.vertices[static_cast<size_t>(t[0])], &b = mesh.vertices[static_cast<size_t>(t[1])],
+             &c = mesh.vertices[static_cast<size_t>(t[2])];
+  const Vec3 cross = (b - a).cross(c - a);
+  if (!(cross.norm() > 0)) return;
+  const Vec3 n = cross.normalized();
+  if (std::abs(n.dot(line)) > kParallel || std::abs((m - a).dot(n)) > tolerance) return;
+  const std::array<Vec3, 3> corner{a, b, c};
+  const Vec3 across = n.cross(line).normalized();
+  bool in_plus = true, in_minus = true;
+  for (int k = 0; k < 3; ++k) {
+    const Vec3& p = corner[static_cast<size_t>(k)];
+    const Vec3 inward = n.cross(corner[static_cast<size_t>((k + 1) % 3)] - p).normalized();  // counter-clockwise
+    const double d = (m - p).dot(inward);
+    if (d < -tolerance) return;  // outside
+    if (d > tolerance) continue;  // m is not on this edge
+    in_plus = in_plus && across.dot(inward) > kParallel;
+    in_minus = in_minus && -across.dot(inward) > kParallel;
+  }
+  if (in_plus) out->push_back(across);
+  if (in_minus) out->push_back(-across);
+}
+
+// Directions within the angle whose cosine is `same` are one half-sheet.
+size_t DistinctDirections(const std::vector<Vec3>& dirs, double same) {
+  size_t distinct = 0;
+  for (size_t i = 0; i < dirs.size(); ++i) {
+    bool seen = false;
+    for (size_t j = 0; j < i && !seen; ++j) seen = dirs[i].dot(dirs[j]) > same;
+    distinct += !seen;
+  }
+  return distinct;
+}
+
+}  // namespace
+
+CurveSegments CrossingCurves(const TriangleMesh& mesh, double tolerance, double min_angle_deg) {
+  const double min_sine = std::sin(min_angle_deg * M_PI / 180.0), same = std::cos(min_angle_deg * M_PI / 180.0);
+  const size_t nf = mesh.faces.size();
+  std::vector<FaceBox> boxes;  // box_self_intersection_d reorders them
+  std::vector<Eigen::AlignedBox3d> bound;  // per face
+  boxes.reserve(nf);
+  bound.reserve(nf);
+  for (size_t f = 0; f < nf; ++f) {
+    const Tri& t = mesh.faces[f];
+    double lo[3], hi[3];
+    for (int k = 0; k < 3; ++k) {
+      lo[k] = std::min({mesh.vertices[t[0]][k], mesh.vertices[t[1]][k], mesh.vertices[t[2]][k]}) - tolerance;
+      hi[k] = std::max({mesh.vertices[t[0]][k], mesh.vertices[t[1]][k], mesh.vertices[t[2]][k]}) + tolerance;
+    }
+    boxes.emplace_back(lo, hi, static_cast<int>(f));
+    bound.emplace_back(Vec3(lo[0], lo[1], lo[2]), Vec3(hi[0], hi[1], hi[2]));
+  }
+  // Every pair of triangles whose boxes meet: the candidates, and the triangles near a candidate's segment
+  // (a triangle through the segment's midpoint meets both triangles, so its box is paired with theirs).
+  std::vector<std::pair<int, int>> pairs;
+  CGAL::box_self_intersection_d(boxes.begin(), boxes.end(), [&](const FaceBox& x, const FaceBox& y) {
+    pairs.emplace_back(std::min(x.info(), y.info()), std::max(x.info(), y.info()));
+  });
+  std::sort(pairs.begin(), pairs.end());
+  pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
+  std::vector<std::vector<int>> near(nf);
+  for (const auto& [f, g] : pairs) {
+    near[static_cast<size_t>(f)].push_back(g);
+    near[static_cast<size_t>(g)].push_back(f);
+  }
+
+  CurveSegments out;
+  // Segments already judged, by the grid cells they pass through: the same piece found from another pair
+  // (the walls of two touching parts each meet the other's face along one line) is judged once, kept once.
+  std::vector<std::array<Vec3, 2>> judged;
+  std::vector<char> judged_kept;
+  std::unordered_map<int64_t, std::vector<size_t>> judged_by_cell;
+  constexpr double cell = 0.01;  // of the normalised frame's unit box
+  auto key = [&](const Vec3& p, int dx, int dy, int dz) {
+    const int64_t x = static_cast<int64_t>(std::floor(p.x() / cell)) + dx;
+    const int64_t y = static_cast<int64_t>(std::floor(p.y() / cell)) + dy;
+    const int64_t z = static_cast<int64_t>(std::floor(p.z() / cell)) + dz;
+    return (x * 73856093) ^ (y * 19349663) ^ (z * 83492791);
+  };
+  auto judged_through = [&](const Vec3& m) -> bool {  // a segment through m was judged already
+    for (int dx = -1; dx <= 1; ++dx)
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dz = -1; dz <= 1; ++dz) {
+          const auto it = judged_by_cell.find(key(m, dx, dy, dz));
+          if (it == judged_by_cell.end()) continue;
+          for (size_t e : it->second) {
+            const Vec3 &a = judged[e][0], ab = judged[e][1] - judged[e][0];
+            const double s = std::clamp((m - a).dot(ab) / ab.squaredNorm(), 0.0, 1.0);
+            if ((a + s * ab - m).norm() <= tolerance) return true;
+          }
+        }
+    return false;
+  };
+  auto judge = [&](const Vec3& p, const Vec3& q, bool keep) {
+    const size_t e = judged.size();
+    judged.push_back({p, q});
+    judged_kept.push_back(keep);
+    const int steps = std::max(1, static_cast<int>(std::ceil((q - p).norm() / (0.5 * cell))));
+    for (int k = 0; k <= steps; ++k) {
+      std::vector<size_t>& in = judged_by_cell[key(p + (q - p) * (static_cast<double>(k) / steps), 0, 0, 0)];
+      if (in.empty() || in.back() != e) in.push_back(e);
+    }
+    if (!keep) return;
+    const int first = static_cast<int>(out.vertices.size());
+    out.vertices.push_back(p);
+    out.vertices.push_back(q);
+    out.edges.push_back({first, first + 1});
+  };
+  std::vector<Vec3> dirs;
+  for (const auto& [f, g] : pairs) {
+    const Tri& tf = mesh.faces[static_cast<size_t>(f)];
+    const Tri& tg = mesh.faces[static_cast<size_t>(g)];
+    if (SharedVertices(tf, tg) >= 2) continue;  // neighbours across an edge
+    Vec3 p, q;
+    if (!MeetingSegment(mesh, tf, tg, tolerance, min_sine, &p, &q)) continue;
+    const Vec3 m = 0.5 * (p + q), line = (q - p).normalized();
+    if (judged_through(m)) continue;
+    dirs.clear();
+    auto add = [&](int h) {  // only triangles whose box holds m can pass through it
+      if (bound[static_cast<size_t>(h)].contains(m)) HalfSheets(mesh, mesh.faces[static_cast<size_t>(h)], m, line, tolerance, &dirs);
+    };
+    add(f);
+    add(g);
+    for (int h : near[static_cast<size_t>(f)])
+      if (h != g) add(h);
+    for (int h : near[static_cast<size_t>(g)])
+      if (h != f && !std::binary_search(near[static_cast<size_t>(f)].begin(), near[static_cast<size_t>(f)].end(), h))
+        add(h);
+    judge(p, q, DistinctDirections(dirs, same) >= 3);
+  }
+  return out;
+}
+
+}  // namespace voroudf

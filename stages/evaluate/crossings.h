@@ -1,0 +1,37 @@
+#pragma once
+// The non-manifold curves of a reference's surface that its connectivity does not show (docs/evaluate.md,
+// "Non-manifold curves of the reference"). A UDF is the distance to the union of the triangles; where two
+// parts of a mesh cross, or touch along a line without sharing its vertices (parts modelled separately and
+// placed against each other), the union branches there although no edge of the mesh has 3 faces. The mesh
+// a UDF mesher makes of it has branching edges there, rightly.
+#include <vector>
+
+#include "common/mesh_topology.h"
+#include "common/types.h"
+
+namespace voroudf {
+
+/// Segments where the union of `mesh`'s triangles is non-manifold away from its edges of 3+ faces: pieces of
+/// the intersection of two non-coplanar triangles along which 3 or more half-sheets of the union meet.
+/// The half-sheets at a piece are counted at its midpoint m over every triangle within `tolerance` of m whose
+/// plane contains the piece's line: the directions across the line, in its plane, that point into it from m
+/// (2 where m is inside it, 1 where m is on its edge); directions within `min_angle_deg` of each other count once (the coincident walls of two touching
+/// parts; two sheets crossing at a smaller angle, such as two nearly coincident faceted surfaces, are one sheet to a
+/// UDF mesher, as a crease below the feature angle is no feature). So two parts crossing give 4, a part
+/// whose face ends on another's gives 3 (both non-manifold), and two faces meeting at an edge with
+/// unshared vertices give 2 (a seam or crease: not reported). Pieces on an
+/// edge of the mesh are not reported (its edges of 3+ faces are NonManifoldEdges' business).
+///
+/// Candidate pairs from CGAL's box intersection over the triangles' bounding boxes; each pair whose planes
+/// cross (at more than 1 degree) meets along its planes' line clipped to both triangles.
+/// \param mesh           welded (WeldVertices), in the normalised frame
+/// \param tolerance      distance below which a point lies on a triangle (the weld tolerance)
+/// \param min_angle_deg  sheets closer in angle than this are one (evaluate's --feature-angle)
+/// \returns the segments as vertices + edges, in a deterministic order (independent of threads)
+struct CurveSegments {
+  std::vector<Vec3> vertices;
+  std::vector<Edge> edges;
+};
+CurveSegments CrossingCurves(const TriangleMesh& mesh, double tolerance, double min_angle_deg);
+
+}  // namespace voroudf
