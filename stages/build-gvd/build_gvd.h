@@ -19,7 +19,8 @@ namespace voroudf {
 struct BuildGvdOptions {
   /// Dense samples drawn per seed before projection (--samples-per-seed). The kNN graph spans about
   /// sqrt(knn / samples_per_seed) seed spacings, and the wider it is, the more spurious 4-label junctions
-  /// (flat tetrahedra for thin-mesh) appear; 100 keeps it near a third of a spacing at ~1 s for 3k seeds.
+  /// (flat tetrahedra for thin-mesh) appear; 200 keeps it near a third of a spacing (docs/build-gvd.md,
+  /// "Why these defaults").
   double samples_per_seed = 200.0;
   /// Fraction of the dense samples drawn uniformly in the domain box (--space-fraction); the rest are drawn
   /// in balls around the seeds. Box samples project preferentially onto sharp edges, corners and open

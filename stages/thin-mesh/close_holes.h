@@ -1,7 +1,7 @@
 #pragma once
 // thin-mesh's last step (docs/thin-mesh.md, step 4): closing the gaps a junction leaves when the dual missed
-// its face. The one repair the locally Delaunay dual still needs, measured (60-run non-manifold sweep:
-// 45 of 60 runs pass with it, 20 without; docs/thin-mesh.md).
+// its face. The one repair the locally Delaunay dual still needs, measured on the non-manifold sweep
+// (docs/reports/design-notes.md, thin-mesh).
 #include <cstddef>
 #include <vector>
 
