@@ -11,6 +11,7 @@
 #include "common/shapes.h"
 #include "formats/mesh_io.h"
 #include "formats/seeds_io.h"
+#include "stages/thin-mesh/rim_flaps.h"
 #include "stages/thin-mesh/thin_mesh.h"
 #include "tests/support/test_support.h"
 
@@ -433,10 +434,12 @@ TriangleMesh Bipyramid(double z_up, double z_down) {
   return m;
 }
 
-// MinFaces(1) without step 6: the fins of WithFins reach beyond the disc's field, off the surface at a rim.
+// MinFaces(1) without steps 5b and 6: the fins of WithFins reach beyond the disc's field, off the surface at
+// a rim, and some lie within the overlap angle of a shell face they stand on, like folds.
 ThinMeshOptions ShellsOnly() {
   ThinMeshOptions o = MinFaces(1);
   o.rim_flaps = false;
+  o.fold_flaps = false;
   return o;
 }
 
@@ -593,6 +596,67 @@ TEST_F(ThinMeshExe, BadInputExitsThreeAndWritesNothing) {
                                "--degenerate-quality", "-1"});
   EXPECT_EQ(r.exit_code, 2) << r.err;
   EXPECT_EQ(dir_.List().size(), 2u) << "only bad.ply and seeds.ply";
+}
+
+// ---- step 5b: folded flaps ----
+
+// The 4 x 4 grid of unit cells in z = 0, each cell (a, b, d), (a, d, c) with a its lower left corner.
+TriangleMesh GridSheet() {
+  TriangleMesh m;
+  for (int j = 0; j <= 4; ++j)
+    for (int i = 0; i <= 4; ++i) m.vertices.emplace_back(i, j, 0);
+  for (int j = 0; j < 4; ++j)
+    for (int i = 0; i < 4; ++i) {
+      const int a = j * 5 + i, b = a + 1, c = a + 5, d = c + 1;
+      m.faces.push_back({a, b, d});
+      m.faces.push_back({a, d, c});
+    }
+  return m;
+}
+
+size_t EdgesWithFaces(const std::vector<Tri>& faces, size_t at_least) {
+  const EdgeFaces inc = BuildEdgeFaces(faces);
+  return static_cast<size_t>(
+      std::count_if(inc.faces.begin(), inc.faces.end(), [&](const auto& f) { return f.size() >= at_least; }));
+}
+
+TEST(ThinMeshFolds, AFaceWithAFreeEdgeFoldedOverAnotherAtABranchingEdgeGoes) {
+  TriangleMesh m = GridSheet();
+  const std::vector<Tri> sheet = m.faces;
+  // The flap: on the diagonal (1,1)-(2,2) of the sheet, its third vertex (3,2) on the side of (2,1), i.e.
+  // folded over the face (1,1), (2,1), (2,2); its edge (1,1)-(3,2) is free, (2,2)-(3,2) a third face.
+  const int a = 6, d = 12, x = 13;
+  m.faces.push_back({a, d, x});
+  ASSERT_EQ(EdgesWithFaces(m.faces, 3), 2u);
+  EXPECT_EQ(RemoveFoldedFlaps(m.vertices, m.faces, 25.0), 1u);
+  EXPECT_EQ(m.faces, sheet);  // the sheet as it was, in its order
+  EXPECT_EQ(EdgesWithFaces(m.faces, 3), 0u);
+  // Unfolded (its third vertex lifted to 45 degrees over the sheet: outside the overlap angle), it stays.
+  TriangleMesh lifted = GridSheet();
+  lifted.vertices.emplace_back(2.5, 1.5, 0.5 * std::sqrt(2.0) * 1.0);  // 45 degrees up from the diagonal
+  lifted.faces.push_back({a, d, static_cast<int>(lifted.vertices.size()) - 1});
+  EXPECT_EQ(RemoveFoldedFlaps(lifted.vertices, lifted.faces, 25.0), 0u);
+}
+
+TEST(ThinMeshFolds, BranchingSheetsAndFoldsWithoutAFreeEdgeStay) {
+  // Three half-planes on one spine, 120 degrees apart, each with free outer edges: a branching curve.
+  TriangleMesh book;
+  book.vertices = {Vec3(0, 0, 0), Vec3(0, 0, 1)};
+  for (int k = 0; k < 3; ++k) {
+    const Vec3 out(std::cos(2 * M_PI * k / 3), std::sin(2 * M_PI * k / 3), 0);
+    const int o = static_cast<int>(book.vertices.size());
+    book.vertices.push_back(out);
+    book.vertices.push_back(out + Vec3(0, 0, 1));
+    book.faces.push_back({0, o, o + 1});
+    book.faces.push_back({0, o + 1, 1});
+  }
+  EXPECT_EQ(RemoveFoldedFlaps(book.vertices, book.faces, 25.0), 0u);
+  EXPECT_EQ(book.faces.size(), 6u);
+  // A second layer without a free edge (a face repeated over the sheet's own vertices) is not a flap.
+  TriangleMesh doubled = GridSheet();
+  doubled.faces.push_back({6, 12, 7});
+  doubled.faces.push_back({6, 12, 11});
+  EXPECT_EQ(RemoveFoldedFlaps(doubled.vertices, doubled.faces, 25.0), 0u);
 }
 
 }  // namespace

@@ -34,6 +34,9 @@ int main(int argc, char** argv) {
   app.add_option("--rim-flaps", options.rim_flaps,
                  "remove the faces hanging from a free edge across a non-manifold edge where the edges they leave "
                  "open lie on a rim (true/false; not with --thinning paper)");
+  app.add_option("--fold-flaps", options.fold_flaps,
+                 "remove the faces hanging from a free edge folded over another face of a non-manifold edge "
+                 "(within --overlap-angle), then close the holes again (true/false; not with --thinning paper)");
   app.add_option("--shell-rings", options.shell_rings,
                  "open the closed shells the paper's steps leave (bubbles no face pair can thin) that lie within "
                  "this many edges of one of their faces, at a face off the surface (0: off; not with --thinning paper)");

@@ -36,12 +36,45 @@ bool OnRim(const Udf& udf, const std::vector<Vec3>& p, int a, int b, int inner) 
   return *std::min_element(d.begin(), d.end()) > 0.3 * radius;
 }
 
+// Faces removed one by one in face order, with each edge's live face count (both steps' bookkeeping).
+struct LiveFaces {
+  const std::vector<Tri>& faces;
+  EdgeFaces inc;
+  std::vector<int> count;
+  std::vector<char> alive;
+
+  explicit LiveFaces(const std::vector<Tri>& f) : faces(f), inc(BuildEdgeFaces(f)), count(inc.edges.size()), alive(f.size(), 1) {
+    for (size_t e = 0; e < count.size(); ++e) count[e] = static_cast<int>(inc.faces[e].size());
+  }
+  std::array<int, 3> Edges(size_t f) const {
+    const Tri& t = faces[f];
+    std::array<int, 3> e;
+    for (int k = 0; k < 3; ++k) e[static_cast<size_t>(k)] = inc.Find(t[static_cast<size_t>(k)], t[static_cast<size_t>((k + 1) % 3)]);
+    return e;
+  }
+  bool HasFreeEdge(const std::array<int, 3>& e) const {
+    for (int x : e)
+      if (count[static_cast<size_t>(x)] == 1) return true;
+    return false;
+  }
+  void Remove(size_t f) {
+    alive[f] = 0;
+    for (int x : Edges(f)) --count[static_cast<size_t>(x)];
+  }
+  std::vector<Tri> Kept() const {
+    std::vector<Tri> kept;
+    for (size_t f = 0; f < faces.size(); ++f)
+      if (alive[f]) kept.push_back(faces[f]);
+    return kept;
+  }
+};
+
 }  // namespace
 
 size_t RemoveRimFlaps(const Udf& udf, const std::vector<Vec3>& v, std::vector<Tri>& faces) {
-  const EdgeFaces inc = BuildEdgeFaces(faces);
-  std::vector<int> count(inc.edges.size());
-  for (size_t e = 0; e < count.size(); ++e) count[e] = static_cast<int>(inc.faces[e].size());
+  LiveFaces live(faces);
+  const EdgeFaces& inc = live.inc;
+  std::vector<int>& count = live.count;
   // Centroid UDFs, in one batch, of the faces that can be flaps: counts only fall, so a face on no branching
   // edge now never stands on one.
   std::vector<double> centroid_udf(faces.size(), 0.0);
@@ -59,17 +92,13 @@ size_t RemoveRimFlaps(const Udf& udf, const std::vector<Vec3>& v, std::vector<Tr
   std::vector<Vec3> asked_grad;
   if (!centroid.empty()) udf.Evaluate(centroid, asked_udf, asked_grad);
   for (size_t k = 0; k < asked.size(); ++k) centroid_udf[asked[k]] = asked_udf[k];
-  std::vector<char> alive(faces.size(), 1);
   size_t removed = 0;
   for (size_t f = 0; f < faces.size(); ++f) {
     const Tri& t = faces[f];
-    std::array<int, 3> e;
-    for (int k = 0; k < 3; ++k) e[static_cast<size_t>(k)] = inc.Find(t[static_cast<size_t>(k)], t[static_cast<size_t>((k + 1) % 3)]);
-    bool free_edge = false, branching = false;
-    for (int x : e) {
-      free_edge = free_edge || count[static_cast<size_t>(x)] == 1;
-      branching = branching || count[static_cast<size_t>(x)] >= 3;
-    }
+    const std::array<int, 3> e = live.Edges(f);
+    bool branching = false;
+    for (int x : e) branching = branching || count[static_cast<size_t>(x)] >= 3;
+    const bool free_edge = live.HasFreeEdge(e);
     if (!free_edge || !branching) continue;
     if (!OffSurface(centroid_udf[f], v[static_cast<size_t>(t[0])], v[static_cast<size_t>(t[1])],
                     v[static_cast<size_t>(t[2])]))
@@ -79,21 +108,47 @@ size_t RemoveRimFlaps(const Udf& udf, const std::vector<Vec3>& v, std::vector<Tr
       const size_t x = static_cast<size_t>(e[static_cast<size_t>(k)]);
       if (count[x] != 2) continue;
       for (int g : inc.faces[x]) {
-        if (g == static_cast<int>(f) || !alive[static_cast<size_t>(g)]) continue;
+        if (g == static_cast<int>(f) || !live.alive[static_cast<size_t>(g)]) continue;
         const Tri& o = faces[static_cast<size_t>(g)];
         const int a = inc.edges[x][0], b = inc.edges[x][1];
         opens = !OnRim(udf, v, a, b, o[0] + o[1] + o[2] - a - b);
       }
     }
     if (opens) continue;
-    alive[f] = 0;
-    for (int x : e) --count[static_cast<size_t>(x)];
+    live.Remove(f);
     ++removed;
   }
-  std::vector<Tri> kept;
-  for (size_t f = 0; f < faces.size(); ++f)
-    if (alive[f]) kept.push_back(faces[f]);
-  faces = std::move(kept);
+  faces = live.Kept();
+  return removed;
+}
+
+size_t RemoveFoldedFlaps(const std::vector<Vec3>& v, std::vector<Tri>& faces, double overlap_angle_deg) {
+  const double min_cos = std::cos(overlap_angle_deg * M_PI / 180.0);
+  LiveFaces live(faces);
+  auto away = [&](int f, const Edge& ab) {  // from edge ab towards face f's third vertex, unit
+    const Tri& t = faces[static_cast<size_t>(f)];
+    const Vec3 a = v[static_cast<size_t>(ab[0])], axis = (v[static_cast<size_t>(ab[1])] - a).normalized();
+    Vec3 d = v[static_cast<size_t>(t[0] + t[1] + t[2] - ab[0] - ab[1])] - a;
+    d -= d.dot(axis) * axis;
+    return Vec3(d.normalized());
+  };
+  size_t removed = 0;
+  for (size_t f = 0; f < faces.size(); ++f) {
+    const std::array<int, 3> e = live.Edges(f);
+    if (!live.HasFreeEdge(e)) continue;
+    bool folded = false;
+    for (int x : e) {
+      if (live.count[static_cast<size_t>(x)] < 3 || folded) continue;
+      const Edge& ab = live.inc.edges[static_cast<size_t>(x)];
+      const Vec3 mine = away(static_cast<int>(f), ab);
+      for (int g : live.inc.faces[static_cast<size_t>(x)])
+        folded = folded || (g != static_cast<int>(f) && live.alive[static_cast<size_t>(g)] && away(g, ab).dot(mine) >= min_cos);
+    }
+    if (!folded) continue;
+    live.Remove(f);
+    ++removed;
+  }
+  faces = live.Kept();
   return removed;
 }
 

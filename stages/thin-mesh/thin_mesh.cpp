@@ -511,6 +511,14 @@ TriangleMesh ThinMesh(const Udf& udf, const TriangleMesh& thick, const ThinMeshO
         monitor.Info(Count(st.tetrahedra_closed_thinned, "tetrahedra that step 4 closed thinned"));
       kept = AliveFaces(flaps);
     }
+    if (options.fold_flaps) {
+      // 5b. Folded flaps: a collapse each; the holes they bordered, one face larger, get step 4's closing.
+      st.folded_flaps_removed = RemoveFoldedFlaps(thick.vertices, kept, options.overlap_angle_deg);
+      if (st.folded_flaps_removed > 0)
+        st.holes_closed_after_folds = CloseTriangularHoles(thick.vertices, kept, options.degenerate_quality, min_cos);
+      monitor.Info(Count(st.folded_flaps_removed, "folded flaps removed, ") +
+                   Count(st.holes_closed_after_folds, "holes closed after them"));
+    }
   }
   if (options.thinning != "paper" && options.rim_flaps) {
     // 6. Flaps at the end of a branching curve, where it meets the rims of its sheets.

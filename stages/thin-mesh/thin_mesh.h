@@ -32,6 +32,9 @@ struct ThinMeshOptions {
   /// --rim-flaps (not with --thinning paper): step 6 removes the faces that hang from a free edge across a
   /// non-manifold edge where every edge they leave with one face lies on a rim (no surface beyond it).
   bool rim_flaps = true;
+  /// --fold-flaps (not with --thinning paper): step 5b removes the faces that hang from a free edge folded
+  /// over another face of a non-manifold edge (within the overlap angle), then closes the holes again.
+  bool fold_flaps = true;
   /// --shell-rings (not with --thinning paper; 0: off): step 3b opens the closed shells that steps 1-3 leave
   /// and whose faces lie within this many edges of one of their faces, at a face off the surface.
   int shell_rings = 1;
@@ -55,6 +58,8 @@ struct ThinMeshStats {
   size_t holes_closed = 0;          ///< step 4: triangular holes and notches given their face
   size_t tetrahedra_closed_thinned = 0;  ///< step 5: tetrahedra that step 4's faces closed, thinned
   size_t flap_faces_removed = 0;    ///< step 5: faces of dangling flaps removed
+  size_t folded_flaps_removed = 0;  ///< step 5b: folded flaps removed
+  size_t holes_closed_after_folds = 0;  ///< step 5b: triangular holes closed after them
   size_t rim_flaps_removed = 0;     ///< step 6: flaps at a rim removed
   int rounds = 0;                   ///< rounds of (tetrahedra, components) until nothing changed
 };
@@ -83,6 +88,9 @@ struct ThinMeshStats {
 ///  5. Then, if step 4 changed anything: the closed tetrahedra (step 1's rule), and a small component (as in
 ///     step 2) that has a free edge is removed when that leaves no border edge with a single face and keeps
 ///     the Euler characteristic (a dangling flap, collapsed from its free edge).
+///  5b. Unless thinning is "paper" or fold_flaps is off: RemoveFoldedFlaps (rim_flaps.h), a face with a free
+///     edge lying over another face of a non-manifold edge within the overlap angle, a collapse each; then,
+///     if any went, CloseTriangularHoles again.
 ///  6. Unless thinning is "paper" or rim_flaps is off: a face with a free edge and a non-manifold edge is
 ///     removed when every edge it leaves with one face lies on a rim: the UDF shows no surface beyond that
 ///     edge. Where a branching curve ends at the rims of its sheets, the regions of a rim seed of one sheet
