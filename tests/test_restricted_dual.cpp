@@ -5,6 +5,8 @@
 // cross at a gap of the chain of curve seeds, each sheet keeps its triangle on the chain's link.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include <cmath>
 #include <map>
 #include <set>
@@ -179,7 +181,8 @@ TEST(ChainLinks, SeedsOnOneSideOfTheLinkOrNoChainAreLeftToTheCharts) {
   const std::vector<Tri> tet = AllTriples(4);
   EXPECT_EQ(KeepChainLinks(p, {1, 1, 0, 0}, tet, nullptr), tet);
   // Without curve seeds there is no link: the crossing cluster is left as it is.
-  const std::vector<Tri> all = CrossingTriples();
+  std::vector<Tri> all = CrossingTriples();
+  std::sort(all.begin(), all.end());  // as KeepChainLinks returns them
   ChainLinkStats stats;
   EXPECT_EQ(KeepChainLinks(CrossingCluster(0.05, 1), std::vector<uint8_t>(8, 0), all, &stats), all);
   EXPECT_EQ(stats.links, 0u);
@@ -213,13 +216,46 @@ TEST(ChainLinks, ATriangleAlongTheChainJumpingACurveSeedIsDropped) {
   std::vector<Tri> with_sliver = StripTriangles();
   with_sliver.push_back({1, 2, 3});  // seeds 1 and 3 jump over 2
   ChainLinkStats stats;
-  EXPECT_EQ(KeepChainLinks(p, is_curve, with_sliver, &stats), StripTriangles());
+  std::vector<Tri> strip = StripTriangles();
+  std::sort(strip.begin(), strip.end());
+  EXPECT_EQ(KeepChainLinks(p, is_curve, with_sliver, &stats), strip);
   EXPECT_EQ(stats.links, 4u);
   EXPECT_EQ(stats.jumps, 1u);
+  EXPECT_EQ(stats.added, 0u);
   // Where the chain turns by 60 degrees at the middle seed (a corner of the surface), the triangle of the
   // three is a face: kept.
   const std::vector<Vec3> corner = {{-1, 0, 0}, {0, 0, 0}, {0.5, std::sqrt(0.75), 0}};
   EXPECT_EQ(KeepChainLinks(corner, {1, 1, 1}, {{0, 1, 2}}, &stats), (std::vector<Tri>{{0, 1, 2}}));
+  EXPECT_EQ(stats.jumps, 0u);
+}
+
+TEST(ChainLinks, AJumpIsSplitAtTheCurveSeedEvenWhereASheetsHalvesWentUnseen) {
+  // The strip (sheet z = 0) and a second sheet crossing it along the chain, standing up in y = 0: its seed
+  // 13 over the middle seed 2. Near the crossing the samples saw its triangle (1, 3, 13) jumping seed 2,
+  // not the halves (1, 2, 13) and (2, 3, 13).
+  std::vector<Vec3> p;
+  for (int i = 0; i < 5; ++i) p.push_back({double(i), 0, 0});
+  for (int i = 0; i < 4; ++i) p.push_back({i + 0.5, 0.8, 0});
+  for (int i = 0; i < 4; ++i) p.push_back({i + 0.5, -0.8, 0});
+  p.push_back({2, 0, 0.8});
+  std::vector<uint8_t> is_curve(p.size(), 0);
+  std::fill(is_curve.begin(), is_curve.begin() + 5, 1);
+  std::vector<Tri> triples = StripTriangles();
+  triples.push_back({1, 3, 13});
+  ChainLinkStats stats;
+  const std::vector<Tri> kept = KeepChainLinks(p, is_curve, triples, &stats);
+  EXPECT_EQ(stats.jumps, 1u);
+  EXPECT_EQ(stats.added, 2u);
+  std::vector<Tri> expected = StripTriangles();
+  expected.push_back({1, 2, 13});
+  expected.push_back({2, 3, 13});
+  std::sort(expected.begin(), expected.end());
+  EXPECT_EQ(kept, expected);
+  // A curve seed's triangle over the jump is split only where its halves were witnessed: between the
+  // curve seeds of a corner it is no sheet's triangle.
+  std::vector<uint8_t> corner = is_curve;
+  corner[13] = 1;
+  EXPECT_EQ(KeepChainLinks(p, corner, triples, &stats).size(), triples.size());
   EXPECT_EQ(stats.jumps, 0u);
 }
 

@@ -548,7 +548,8 @@ GvdResult BuildGvd(const Udf& udf, const SeedCloud& seeds, const BuildGvdOptions
       ChainLinkStats cl;
       faces = KeepChainLinks(seeds.position, is_curve, faces, &cl);
       monitor.Info(Format("chain links: %zu between curve seeds; %zu triples dropped (%zu jumps over a curve seed, "
-                          "the rest across crossings)", cl.links, cl.dropped, cl.jumps));
+                          "split at it with %zu halves the samples did not see; the rest across crossings)",
+                          cl.links, cl.dropped, cl.jumps, cl.added));
     }
   }
   stats.triangles = faces.size();

@@ -141,21 +141,32 @@ struct LiveTriples {
     third.erase(std::remove_if(third.begin(), third.end(), [&](int x) { return !Has(a, b, x); }), third.end());
     return third;
   }
-  // Drops `drop` unless that leaves an edge with one triple that had more: no new boundary edge.
-  bool DropUnlessItOpens(const std::vector<Tri>& drop) {
-    std::unordered_map<uint64_t, int> after;
+  // Replaces `drop` by `add` (those of it not present) unless that leaves an edge with one triple where it
+  // had more: no new boundary edge. Returns whether it did.
+  bool ReplaceUnlessItOpens(const std::vector<Tri>& drop, const std::vector<Tri>& add) {
+    std::vector<Tri> fresh;
+    for (const Tri& t : add)
+      if (!present.count(t) && std::find(fresh.begin(), fresh.end(), t) == fresh.end()) fresh.push_back(t);
+    std::unordered_map<uint64_t, int> delta;
     for (const Tri& t : drop)
-      for (int k = 0; k < 3; ++k) {
-        const uint64_t e = EdgeKey(MakeEdge(t[k], t[(k + 1) % 3]));
-        after.emplace(e, per_edge.at(e));
-        --after[e];
-      }
-    for (const auto& [e, n] : after)
-      if (n == 1) return false;
+      for (int k = 0; k < 3; ++k) --delta[EdgeKey(MakeEdge(t[k], t[(k + 1) % 3]))];
+    for (const Tri& t : fresh)
+      for (int k = 0; k < 3; ++k) ++delta[EdgeKey(MakeEdge(t[k], t[(k + 1) % 3]))];
+    for (const auto& [e, d] : delta) {
+      const auto it = per_edge.find(e);
+      const int before = it == per_edge.end() ? 0 : it->second;
+      if (before + d == 1 && before > 1) return false;
+    }
     for (const Tri& t : drop) present.erase(t);
-    for (const auto& [e, n] : after) per_edge[e] = n;
+    for (const Tri& t : fresh) {
+      present.insert(t);
+      added.push_back(t);
+    }
+    for (const auto& [e, d] : delta) per_edge[e] += d;
     return true;
   }
+  bool DropUnlessItOpens(const std::vector<Tri>& drop) { return ReplaceUnlessItOpens(drop, {}); }
+  std::vector<Tri> added;  ///< the triples ReplaceUnlessItOpens added, in order
 };
 
 // A chain goes on through a curve seed c where its links to x and y make an angle above this at c; a
@@ -179,13 +190,12 @@ struct Chain {
 };
 
 // A jump: two seeds x, y linked to one curve seed c on either side of it (more than 135 degrees apart at c)
-// and no link themselves. The triples on a jump, (x, y, z), are dropped together where each has its two
-// replacements (x, c, z) and (c, y, z) present (z = c: the sliver along the chain, replaced by nothing)
-// and no edge is left with one triple (KeepChainLinks). Returns the jumps taken.
-size_t DropChainJumps(const std::vector<Vec3>& seeds, const Chain& chain,
+// and no link themselves. The triples on a jump, (x, y, z), are split at c together, unless that leaves an
+// edge with one triple where it had more (KeepChainLinks). Returns the jumps taken.
+size_t DropChainJumps(const std::vector<Vec3>& seeds, const std::vector<uint8_t>& is_curve, const Chain& chain,
                       const std::vector<std::vector<int>>& neighbours, LiveTriples& live) {
   size_t jumps = 0;
-  std::vector<Tri> drop;
+  std::vector<Tri> drop, halves;
   for (size_t ci = 0; ci < chain.linked.size(); ++ci) {
     const auto& ends = chain.linked[ci];
     const int c = static_cast<int>(ci);
@@ -196,13 +206,24 @@ size_t DropChainJumps(const std::vector<Vec3>& seeds, const Chain& chain,
         const Vec3 cx = (seeds[static_cast<size_t>(x)] - seeds[ci]).normalized();
         const Vec3 cy = (seeds[static_cast<size_t>(y)] - seeds[ci]).normalized();
         if (!(cx.dot(cy) < kJumpMaxCos)) continue;  // a bend of the chain or two chains at a corner: no jump
+        // Each triple on the jump is split at c: (x, y, z) becomes (x, c, z) and (c, y, z), the sliver (x, y, c)
+        // nothing. A sheet seed's halves are added where the samples did not witness them (near a crossing a
+        // sheet's half of a junction goes unseen); a curve seed's must be present (among the curve seeds of a
+        // corner where chains meet, a triple is no sheet's).
         drop.clear();
+        halves.clear();
         bool replaced = true;
         for (int z : live.Thirds(x, y, neighbours)) {
-          replaced = replaced && (z == c || (live.Has(x, c, z) && live.Has(c, y, z)));
           drop.push_back(SortedTri({x, y, z}));
+          if (z == c) continue;
+          if (is_curve[static_cast<size_t>(z)]) {
+            replaced = replaced && live.Has(x, c, z) && live.Has(c, y, z);
+          } else {
+            halves.push_back(SortedTri({x, c, z}));
+            halves.push_back(SortedTri({c, y, z}));
+          }
         }
-        if (replaced && live.DropUnlessItOpens(drop)) ++jumps;
+        if (replaced && live.ReplaceUnlessItOpens(drop, halves)) ++jumps;
       }
   }
   return jumps;
@@ -244,13 +265,19 @@ std::vector<Tri> KeepChainLinks(const std::vector<Vec3>& seeds, const std::vecto
   const Chain chain(seeds.size(), ChainLinks(seeds, is_curve, neighbours));
   stats.links = chain.links.size();
   LiveTriples live(triples);
-  stats.jumps = DropChainJumps(seeds, chain, neighbours, live);
+  stats.jumps = DropChainJumps(seeds, is_curve, chain, neighbours, live);
   KeepLinksAcrossCrossings(seeds, chain, is_curve, neighbours, live);
   std::vector<Tri> kept;
   kept.reserve(triples.size());
   for (const Tri& t : triples)
     if (live.present.count(t)) kept.push_back(t);
   stats.dropped = triples.size() - kept.size();
+  const size_t given = kept.size();
+  for (const Tri& t : live.added)  // the splits' halves still present (one dropped before may be back)
+    if (live.present.count(t)) kept.push_back(t);
+  std::sort(kept.begin(), kept.end());
+  kept.erase(std::unique(kept.begin(), kept.end()), kept.end());
+  stats.added = kept.size() - given;
   if (stats_out) *stats_out = stats;
   return kept;
 }

@@ -58,6 +58,7 @@ struct ChainLinkStats {
   size_t links = 0;    ///< chain links found between curve seeds
   size_t jumps = 0;    ///< jumps over a curve seed whose triples were dropped
   size_t dropped = 0;  ///< triples dropped in all
+  size_t added = 0;    ///< triples the splits of jumps added (not witnessed)
 };
 
 /// The triples that follow the feature chains instead of jumping along or across them. A *chain link* is a
@@ -66,8 +67,11 @@ struct ChainLinkStats {
 /// neighbour of both lies strictly inside the sphere with diameter cc' (the Gabriel rule among the curve
 /// seeds; Gabriel & Sokal 1969). Two rules, in this order:
 ///  - **jumps**: where x and y are both linked to a curve seed c, more than 135 degrees apart at c, and are no
-///    link themselves, the triples on xy jump c along the chain. They are dropped, all together, where each
-///    (x, y, z) has its replacements (x, c, z) and (c, y, z) present (z = c: the sliver along the chain).
+///    link themselves, the triples on xy jump c along the chain. Each (x, y, z) is split at c into (x, c, z)
+///    and (c, y, z) (z = c: the sliver along the chain, replaced by nothing). Where z is a sheet seed, the
+///    halves the samples did not witness are added (near a crossing a sheet's half of a junction goes
+///    unseen); where z is a curve seed (a corner where chains meet: no sheet's triangle) both must be
+///    present. All of a jump's triples together, or none.
 ///  - **crossings**: where the four triples of a link cc' and two sheet seeds a, b are all present — a closed
 ///    tetrahedron, two ways of spanning one junction — a and b lie on two sides of the link (their directions
 ///    from it, across it, more than 60 degrees apart) and ab carries 4 or more triples, the two triples on
@@ -76,15 +80,15 @@ struct ChainLinkStats {
 ///    planes), and thin-mesh's pair rule needs an edge of exactly two triples (an edge of two, across a
 ///    crease, is left to it).
 ///
-/// Invariant: a triple is dropped only where the triples that replace it are present, and a drop that would
-/// leave any edge with one triple where it had more is not made: no edge loses its last triple and no new
-/// boundary edge appears, so no hole opens. Jumps and links are taken in seed order on the live triples
-/// (deterministic).
+/// Invariant: a triple is dropped only where the triples that replace it are present or added (a jump's
+/// halves cover its triangle but for the sliver along the chain), and a change that would leave any edge
+/// with one triple where it had more is not made: no new boundary edge appears, so no hole opens. Jumps and
+/// links are taken in seed order on the live triples (deterministic).
 ///
 /// \param seeds     seed positions
 /// \param is_curve  per seed, whether it lies on a feature curve or a corner (rank 2 or 3)
 /// \param triples   triples of seed indices, each vertex triple once, indices sorted
-/// \returns the kept triples in the order given
+/// \returns the kept and added triples, sorted
 std::vector<Tri> KeepChainLinks(const std::vector<Vec3>& seeds, const std::vector<uint8_t>& is_curve,
                                 const std::vector<Tri>& triples, ChainLinkStats* stats);
 
