@@ -601,6 +601,161 @@ SeedState Prepare(const Udf& udf, const SeedCloud& input, const ProjectionOption
   return s;
 }
 
+// Step 8 (docs/optimize-seeds.md, "Feature chains"): seeds added on the feature chains and the sheet seeds
+// beside them dropped; keep_count: as many more crowded sheet seeds dropped as keep the count. No fill leaves
+// more than max(before, (1 + kChainCountSlack) x n) seeds, n the input count.
+struct ChainFill {
+  size_t added = 0, dropped = 0;
+};
+ChainFill FillChains(Optimizer& opt, SeedState& s, const OptimizeSeedsOptions& options, size_t n, int rounds,
+                     bool keep_count) {
+  ChainFill fill;
+  const double spacing = opt.MeanSpacing(s.position);
+  const size_t before = s.position.size();
+  const size_t most = std::max(before, static_cast<size_t>((1.0 + kChainCountSlack) * static_cast<double>(n)));
+  fill.added = opt.RefineFeatureChains(s, options.feature_chord_tol * spacing, options.feature_gap_max * spacing,
+                                       options.feature_clearance * spacing, rounds,
+                                       keep_count ? std::numeric_limits<size_t>::max() : most);
+  if (fill.added == 0) return fill;
+  if (keep_count && s.position.size() > before) DropCrowdedSheetSeeds(s, s.position.size() - before);
+  if (s.position.size() > most) {
+    // Too few sheet seeds to give back (most seeds ranked as features): the last seeds added go again.
+    // Dropped seeds keep their order, so the seeds added are still the last ones.
+    std::vector<char> drop(s.position.size(), 0);
+    std::fill(drop.begin() + static_cast<long>(most), drop.end(), 1);
+    fill.added -= s.position.size() - most;
+    EraseSeeds(s, drop);
+  }
+  fill.dropped = before + fill.added - s.position.size();
+  opt.Analyze(s);
+  return fill;
+}
+
+// One outer iteration (Alg. 1 lines 3-15): the chains filled first (not in the first iteration), the L1
+// tangent step, then repulsion rounds until the delta rule or the cap. Fills report's sigma, energy,
+// inner_rounds and max_inner_move.
+void OuterIteration(Optimizer& opt, SeedState& s, const OptimizeSeedsOptions& options, const RepulsionOptions& repulsion,
+                    int outer, bool chains, size_t n, OuterIterationReport& report, Monitor& monitor) {
+  using Clock = std::chrono::steady_clock;
+  Task task(monitor, "outer iteration " + std::to_string(outer), static_cast<uint64_t>(options.max_inner_iters + 1));
+  // The chains filled before every outer iteration but the first, keeping the count: this iteration's L1
+  // step and repulsion then spread the seeds around the added ones and over the dropped ones' holes.
+  if (chains && outer > 1) {
+    const ChainFill fill = FillChains(opt, s, options, n, kFeatureChainRoundsInLoop, true);
+    monitor.Debug(std::to_string(fill.added) + " seeds added on feature chains, " + std::to_string(fill.dropped) +
+                  " sheet seeds dropped");
+  }
+  // Alg. 1 line 3: the L1 tangent step, then back onto the zero set.
+  const auto l1_t0 = Clock::now();
+  const CellSamples cells = opt.Analyze(s);
+  const auto l1_t1 = Clock::now();
+  const std::vector<Vec3> before = s.position;
+  std::vector<Vec3> stepped = opt.L1Step(s, cells);
+  const auto l1_t2 = Clock::now();
+  const double l1_move = opt.Project(s, before, std::move(stepped), 0.25 * opt.MeanSpacing(s.position));
+  monitor.Debug(Format("  L1 times: cells %.3f s, solve %.3f s, projection %.3f s",
+                       std::chrono::duration<double>(l1_t1 - l1_t0).count(),
+                       std::chrono::duration<double>(l1_t2 - l1_t1).count(),
+                       std::chrono::duration<double>(Clock::now() - l1_t2).count()));
+  task.Advance();
+  // Lines 4–15: the kernel width, then repulsion rounds. σ is computed right after the first round's
+  // cells, so that the movable/fixed split it depends on is the one the round uses.
+  double previous_gradient = -1.0;
+  for (int inner = 1; inner <= options.max_inner_iters; ++inner) {
+    const auto t0 = Clock::now();
+    if (inner == 1 || options.repulsion_cells == "every") {
+      opt.Analyze(s, true);
+    } else {
+      opt.FollowTangentPlanes(s);
+    }
+    if (inner == 1) {
+      report.sigma = opt.KernelWidth(s);
+      if (!std::isfinite(report.sigma)) break;  // every seed is fixed: nothing to repel
+    }
+    const auto t1 = Clock::now();
+    const NeighbourLists neighbours = opt.RepulsionNeighbours(s.position, options.repulsion_cutoff * report.sigma);
+    const RepulsionResult r = MinimizeRepulsion(s.position, s.space, neighbours, report.sigma, repulsion);
+    const auto t2 = Clock::now();
+    const std::vector<Vec3> previous = s.position;
+    report.max_inner_move = std::max(report.max_inner_move, opt.Project(s, previous, r.positions, 0.5 * report.sigma));
+    const auto t3 = Clock::now();
+    monitor.Debug(Format("  times: cells %.3f s, repulsion %.3f s, projection %.3f s",
+                         std::chrono::duration<double>(t1 - t0).count(), std::chrono::duration<double>(t2 - t1).count(),
+                         std::chrono::duration<double>(t3 - t2).count()));
+    report.energy = RepulsionEnergy(s.position, neighbours, report.sigma, nullptr);
+    report.inner_rounds = inner;
+    task.Advance();
+    monitor.Debug(Format("  inner %.0f: energy %.6g -> %.6g, projected gradient %.4g, %.0f L-BFGS iterations",
+                         inner, r.initial_energy, report.energy, r.initial_gradient_norm, r.iterations));
+    const double g = r.initial_gradient_norm;
+    // δ rule (Alg. 1 line 15): the gradient's relative decrease from the previous round is below δ. On
+    // the cells' random samples the gradient settles at a noise floor rather than at a fixed value, so
+    // a round that does not lower it (a signed, not an absolute change) also ends the loop.
+    const bool settled = previous_gradient >= 0.0 && previous_gradient - g <= options.delta * previous_gradient;
+    previous_gradient = g;
+    if (g == 0.0 || settled) break;
+  }
+  task.Advance(static_cast<uint64_t>(options.max_inner_iters - report.inner_rounds));
+  monitor.Debug(Format("L1 step moved seeds up to %.3g (relative)", l1_move / opt.diagonal()));
+}
+
+// Last L1 steps: repulsion moves a seed on a curved feature (a circle) along its tangent, and projection
+// brings it back to the surface but not exactly onto the feature. Only seeds whose cells see a feature
+// (rank ≥ 2) take them: a sheet seed beside an edge would otherwise be pulled onto the edge next to the
+// seeds already there, undoing the last repulsion's spacing (fandisk 3k: spacing CV 0.26 -> 0.31 with
+// every seed, see docs). More than one: a seed whose cell sees the second sheet only after the first step
+// (rank 1 -> 2) gets onto the curve in the next (crossing-planes and sphere-disc, 25 runs: seeds left
+// 0.003–0.007 off the curve with one step, none with three).
+// Step 7 as a function of the state: run again after step 8 (below).
+// A sheet seed beside a curve may see the second sheet only once its neighbours have stepped (rank 1 -> 2
+// at a later analysis) and would end ranked as a feature but off it (sphere-disc, 200 seeds: 0.35
+// spacings off the equator): the steps go on, kFeatureExtraSteps at most, while some feature seed's step
+// would move it more than kFeatureSettledMove spacings.
+// With `around` (the seeds added by step 8), only the seeds within kSettleReach spacings of one of them
+// step: the others' cells are as the first settling left them.
+size_t SettleFeatures(Optimizer& opt, SeedState& s, const OptimizeSeedsOptions& options, bool chains,
+                      const std::vector<Vec3>* around) {
+  size_t crowded = 0;
+  const int steps = options.max_outer_iters > 0 ? options.feature_steps : 0;
+  const int most = steps > 0 ? steps + (chains ? kFeatureExtraSteps : 0) : 0;
+  std::unique_ptr<SeedIndex> around_index;
+  if (around && !around->empty()) around_index = std::make_unique<SeedIndex>(*around);
+  std::vector<char> movers;
+  std::vector<int> near;
+  for (int step = 0;; ++step) {
+    const CellSamples cells = opt.Analyze(s);
+    std::vector<double> misfit;
+    std::vector<Vec3> targets;
+    bool move = step < most;
+    if (move && around_index) {
+      const double reach = kSettleReach * opt.MeanSpacing(s.position);
+      movers.assign(s.position.size(), 0);
+      for (size_t i = 0; i < s.position.size(); ++i) {
+        around_index->WithinRadius(s.position[i], reach, near);
+        movers[i] = !near.empty();
+      }
+    }
+    if (move) targets = opt.L1Step(s, cells, true, &misfit, around_index ? &movers : nullptr);
+    if (move && step >= steps) {
+      const double settled = kFeatureSettledMove * opt.MeanSpacing(s.position);
+      move = false;
+      for (size_t i = 0; i < targets.size() && !move; ++i) move = (targets[i] - s.position[i]).norm() > settled;
+    }
+    if (!move) {
+      // The ranks at the final positions; then the seeds crowding a higher-ranked feature seed there.
+      if (options.feature_clearance > 0.0) crowded += opt.DropCrowded(s, cells);
+      return crowded;
+    }
+    // Seeds whose steps meet are thinned before the move (the better fitting target stays): otherwise two
+    // corner seeds both step onto one corner, Project undoes both moves as too near, and neither reaches it.
+    if (options.feature_clearance > 0.0) {
+      crowded += ThinCrowded(s, targets, misfit, options.feature_clearance * opt.MeanSpacing(s.position), &targets);
+    }
+    const std::vector<Vec3> before = s.position;
+    opt.Project(s, before, std::move(targets), 0.25 * opt.MeanSpacing(s.position));
+  }
+}
+
 }  // namespace
 
 SeedCloud OptimizeSeeds(const Udf& udf, const SeedCloud& input, const OptimizeSeedsOptions& options, Monitor& monitor,
@@ -623,101 +778,13 @@ SeedCloud OptimizeSeeds(const Udf& udf, const SeedCloud& input, const OptimizeSe
   RepulsionOptions repulsion;
   repulsion.max_iterations = options.lbfgs_max_iters;
   repulsion.max_step = options.max_step;
-  // Step 8 (docs/optimize-seeds.md, "Feature chains"): seeds added on the feature chains and the sheet seeds
-  // beside them dropped; keep_count: as many more crowded sheet seeds dropped as keep the count.
   const bool chains = (options.feature_chord_tol > 0.0 || options.feature_gap_max > 0.0) && options.max_outer_iters > 0;
-  struct ChainFill {
-    size_t added = 0, dropped = 0;
-  };
-  auto fill_chains = [&](int rounds, bool keep_count) {
-    ChainFill fill;
-    const double spacing = opt.MeanSpacing(s.position);
-    const size_t before = s.position.size();
-    const size_t most = std::max(before, static_cast<size_t>((1.0 + kChainCountSlack) * static_cast<double>(n)));
-    fill.added = opt.RefineFeatureChains(s, options.feature_chord_tol * spacing, options.feature_gap_max * spacing,
-                                         options.feature_clearance * spacing, rounds,
-                                         keep_count ? std::numeric_limits<size_t>::max() : most);
-    if (fill.added == 0) return fill;
-    if (keep_count && s.position.size() > before) DropCrowdedSheetSeeds(s, s.position.size() - before);
-    if (s.position.size() > most) {
-      // Too few sheet seeds to give back (most seeds ranked as features): the last seeds added go again.
-      // Dropped seeds keep their order, so the seeds added are still the last ones.
-      std::vector<char> drop(s.position.size(), 0);
-      std::fill(drop.begin() + static_cast<long>(most), drop.end(), 1);
-      fill.added -= s.position.size() - most;
-      EraseSeeds(s, drop);
-    }
-    fill.dropped = before + fill.added - s.position.size();
-    opt.Analyze(s);
-    return fill;
-  };
   double previous_sigma = 0.0, previous_cv = cv_in;
   for (int outer = 1; outer <= options.max_outer_iters; ++outer) {
     const auto outer_start = Clock::now();
     OuterIterationReport report;
     report.iteration = outer;
-    {
-      Task task(monitor, "outer iteration " + std::to_string(outer), static_cast<uint64_t>(options.max_inner_iters + 1));
-      // The chains filled before every outer iteration but the first, keeping the count: this iteration's L1
-      // step and repulsion then spread the seeds around the added ones and over the dropped ones' holes.
-      if (chains && outer > 1) {
-        const ChainFill fill = fill_chains(kFeatureChainRoundsInLoop, true);
-        monitor.Debug(std::to_string(fill.added) + " seeds added on feature chains, " + std::to_string(fill.dropped) +
-                      " sheet seeds dropped");
-      }
-      // Alg. 1 line 3: the L1 tangent step, then back onto the zero set.
-      const auto l1_t0 = Clock::now();
-      const CellSamples cells = opt.Analyze(s);
-      const auto l1_t1 = Clock::now();
-      const std::vector<Vec3> before = s.position;
-      std::vector<Vec3> stepped = opt.L1Step(s, cells);
-      const auto l1_t2 = Clock::now();
-      const double l1_move = opt.Project(s, before, std::move(stepped), 0.25 * opt.MeanSpacing(s.position));
-      monitor.Debug(Format("  L1 times: cells %.3f s, solve %.3f s, projection %.3f s",
-                           std::chrono::duration<double>(l1_t1 - l1_t0).count(),
-                           std::chrono::duration<double>(l1_t2 - l1_t1).count(),
-                           std::chrono::duration<double>(Clock::now() - l1_t2).count()));
-      task.Advance();
-      // Lines 4–15: the kernel width, then repulsion rounds. σ is computed right after the first round's
-      // cells, so that the movable/fixed split it depends on is the one the round uses.
-      double previous_gradient = -1.0;
-      for (int inner = 1; inner <= options.max_inner_iters; ++inner) {
-        const auto t0 = Clock::now();
-        if (inner == 1 || options.repulsion_cells == "every") {
-          opt.Analyze(s, true);
-        } else {
-          opt.FollowTangentPlanes(s);
-        }
-        if (inner == 1) {
-          report.sigma = opt.KernelWidth(s);
-          if (!std::isfinite(report.sigma)) break;  // every seed is fixed: nothing to repel
-        }
-        const auto t1 = Clock::now();
-        const NeighbourLists neighbours = opt.RepulsionNeighbours(s.position, options.repulsion_cutoff * report.sigma);
-        const RepulsionResult r = MinimizeRepulsion(s.position, s.space, neighbours, report.sigma, repulsion);
-        const auto t2 = Clock::now();
-        const std::vector<Vec3> previous = s.position;
-        report.max_inner_move = std::max(report.max_inner_move, opt.Project(s, previous, r.positions, 0.5 * report.sigma));
-        const auto t3 = Clock::now();
-        monitor.Debug(Format("  times: cells %.3f s, repulsion %.3f s, projection %.3f s",
-                             std::chrono::duration<double>(t1 - t0).count(), std::chrono::duration<double>(t2 - t1).count(),
-                             std::chrono::duration<double>(t3 - t2).count()));
-        report.energy = RepulsionEnergy(s.position, neighbours, report.sigma, nullptr);
-        report.inner_rounds = inner;
-        task.Advance();
-        monitor.Debug(Format("  inner %.0f: energy %.6g -> %.6g, projected gradient %.4g, %.0f L-BFGS iterations",
-                             inner, r.initial_energy, report.energy, r.initial_gradient_norm, r.iterations));
-        const double g = r.initial_gradient_norm;
-        // δ rule (Alg. 1 line 15): the gradient's relative decrease from the previous round is below δ. On
-        // the cells' random samples the gradient settles at a noise floor rather than at a fixed value, so
-        // a round that does not lower it (a signed, not an absolute change) also ends the loop.
-        const bool settled = previous_gradient >= 0.0 && previous_gradient - g <= options.delta * previous_gradient;
-        previous_gradient = g;
-        if (g == 0.0 || settled) break;
-      }
-      task.Advance(static_cast<uint64_t>(options.max_inner_iters - report.inner_rounds));
-      monitor.Debug(Format("L1 step moved seeds up to %.3g (relative)", l1_move / opt.diagonal()));
-    }
+    OuterIteration(opt, s, options, repulsion, outer, chains, n, report, monitor);
     CountRanks(s, report);
     report.spacing_cv = opt.SpacingStats(s.position).second;
     report.seconds = std::chrono::duration<double>(Clock::now() - outer_start).count();
@@ -743,62 +810,7 @@ SeedCloud OptimizeSeeds(const Udf& udf, const SeedCloud& input, const OptimizeSe
     previous_sigma = report.sigma;
     previous_cv = report.spacing_cv;
   }
-  // Last L1 steps: repulsion moves a seed on a curved feature (a circle) along its tangent, and projection
-  // brings it back to the surface but not exactly onto the feature. Only seeds whose cells see a feature
-  // (rank ≥ 2) take them: a sheet seed beside an edge would otherwise be pulled onto the edge next to the
-  // seeds already there, undoing the last repulsion's spacing (fandisk 3k: spacing CV 0.26 -> 0.31 with
-  // every seed, see docs). More than one: a seed whose cell sees the second sheet only after the first step
-  // (rank 1 -> 2) gets onto the curve in the next (crossing-planes and sphere-disc, 25 runs: seeds left
-  // 0.003–0.007 off the curve with one step, none with three).
-  // Step 7 as a function of the state: run again after step 8 (below).
-  // A sheet seed beside a curve may see the second sheet only once its neighbours have stepped (rank 1 -> 2
-  // at a later analysis) and would end ranked as a feature but off it (sphere-disc, 200 seeds: 0.35
-  // spacings off the equator): the steps go on, kFeatureExtraSteps at most, while some feature seed's step
-  // would move it more than kFeatureSettledMove spacings.
-  // With `around` (the seeds added by step 8), only the seeds within kSettleReach spacings of one of them
-  // step: the others' cells are as the first settling left them.
-  auto settle_features = [&](const std::vector<Vec3>* around) {
-    size_t crowded = 0;
-    const int steps = options.max_outer_iters > 0 ? options.feature_steps : 0;
-    const int most = steps > 0 ? steps + (chains ? kFeatureExtraSteps : 0) : 0;
-    std::unique_ptr<SeedIndex> around_index;
-    if (around && !around->empty()) around_index = std::make_unique<SeedIndex>(*around);
-    std::vector<char> movers;
-    std::vector<int> near;
-    for (int step = 0;; ++step) {
-      const CellSamples cells = opt.Analyze(s);
-      std::vector<double> misfit;
-      std::vector<Vec3> targets;
-      bool move = step < most;
-      if (move && around_index) {
-        const double reach = kSettleReach * opt.MeanSpacing(s.position);
-        movers.assign(s.position.size(), 0);
-        for (size_t i = 0; i < s.position.size(); ++i) {
-          around_index->WithinRadius(s.position[i], reach, near);
-          movers[i] = !near.empty();
-        }
-      }
-      if (move) targets = opt.L1Step(s, cells, true, &misfit, around_index ? &movers : nullptr);
-      if (move && step >= steps) {
-        const double settled = kFeatureSettledMove * opt.MeanSpacing(s.position);
-        move = false;
-        for (size_t i = 0; i < targets.size() && !move; ++i) move = (targets[i] - s.position[i]).norm() > settled;
-      }
-      if (!move) {
-        // The ranks at the final positions; then the seeds crowding a higher-ranked feature seed there.
-        if (options.feature_clearance > 0.0) crowded += opt.DropCrowded(s, cells);
-        return crowded;
-      }
-      // Seeds whose steps meet are thinned before the move (the better fitting target stays): otherwise two
-      // corner seeds both step onto one corner, Project undoes both moves as too near, and neither reaches it.
-      if (options.feature_clearance > 0.0) {
-        crowded += ThinCrowded(s, targets, misfit, options.feature_clearance * opt.MeanSpacing(s.position), &targets);
-      }
-      const std::vector<Vec3> before = s.position;
-      opt.Project(s, before, std::move(targets), 0.25 * opt.MeanSpacing(s.position));
-    }
-  };
-  size_t crowded = settle_features(nullptr);
+  size_t crowded = SettleFeatures(opt, s, options, chains, nullptr);
   const auto [spacing_out, cv_out] = opt.SpacingStats(s.position);
   if (crowded > 0)
     monitor.Info(std::to_string(crowded) + Format(" seeds dropped by the feature-seed thinning (nearer than %.2f x the "
@@ -807,10 +819,10 @@ SeedCloud OptimizeSeeds(const Udf& udf, const SeedCloud& input, const OptimizeSe
   // added seeds change their neighbours' cells: a sheet seed beside a crossing may see the second sheet
   // only now (rank 1 -> 2), so step 7 runs again and every seed ranked as a feature ends on its feature.
   if (chains) {
-    const ChainFill fill = fill_chains(kFeatureChainRounds, false);
+    const ChainFill fill = FillChains(opt, s, options, n, kFeatureChainRounds, false);
     if (fill.added > 0) {
       const std::vector<Vec3> added(s.position.end() - static_cast<long>(fill.added), s.position.end());
-      const size_t settled = settle_features(&added);
+      const size_t settled = SettleFeatures(opt, s, options, chains, &added);
       monitor.Info(std::to_string(fill.added) + " seeds added on feature chains (" +
                    (options.feature_gap_max > 0.0 ? (options.feature_chord_tol > 0.0 ? "gaps, ends, bends" : "gaps, ends")
                                                   : "bends") +
