@@ -27,6 +27,15 @@ struct Box {
   Box Inflated(double margin) const { return {min.array() - margin, max.array() + margin}; }
 };
 
+/// The unit direction from the line through `a` with unit direction `axis` towards `x`, perpendicular to the
+/// line: where faces or seeds around an edge lie, compared by angle (thin-mesh's layer and fold tests,
+/// build-gvd's sides of a chain link).
+inline Vec3 AcrossLine(const Vec3& a, const Vec3& axis, const Vec3& x) {
+  Vec3 d = x - a;
+  d -= d.dot(axis) * axis;
+  return d.normalized();
+}
+
 /// An indexed triangle set. Edges may be shared by any number of faces (non-manifold meshes are first-class).
 struct TriangleMesh {
   std::vector<Vec3> vertices;

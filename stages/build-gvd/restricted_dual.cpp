@@ -238,10 +238,8 @@ void KeepLinksAcrossCrossings(const std::vector<Vec3>& seeds, const Chain& chain
   for (const auto& [c, d] : chain.links) {
     const std::vector<int> third = live.Thirds(c, d, neighbours);
     const Vec3 axis = (seeds[static_cast<size_t>(d)] - seeds[static_cast<size_t>(c)]).normalized();
-    auto across = [&](int x) {  // from the link towards x, across the link: unit
-      Vec3 v = seeds[static_cast<size_t>(x)] - seeds[static_cast<size_t>(c)];
-      v -= v.dot(axis) * axis;
-      return Vec3(v.normalized());
+    auto across = [&](int x) {  // from the link towards x, across the link
+      return AcrossLine(seeds[static_cast<size_t>(c)], axis, seeds[static_cast<size_t>(x)]);
     };
     for (size_t i = 0; i < third.size(); ++i)
       for (size_t j = i + 1; j < third.size(); ++j) {

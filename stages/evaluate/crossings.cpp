@@ -151,7 +151,6 @@ CurveSegments CrossingCurves(const TriangleMesh& mesh, double tolerance, double 
   // Segments already judged, by the grid cells they pass through: the same piece found from another pair
   // (the walls of two touching parts each meet the other's face along one line) is judged once, kept once.
   std::vector<std::array<Vec3, 2>> judged;
-  std::vector<char> judged_kept;
   std::unordered_map<int64_t, std::vector<size_t>> judged_by_cell;
   constexpr double cell = 0.01;  // of the normalised frame's unit box
   auto key = [&](const Vec3& p, int dx, int dy, int dz) {
@@ -177,7 +176,6 @@ CurveSegments CrossingCurves(const TriangleMesh& mesh, double tolerance, double 
   auto judge = [&](const Vec3& p, const Vec3& q, bool keep) {
     const size_t e = judged.size();
     judged.push_back({p, q});
-    judged_kept.push_back(keep);
     const int steps = std::max(1, static_cast<int>(std::ceil((q - p).norm() / (0.5 * cell))));
     for (int k = 0; k <= steps; ++k) {
       std::vector<size_t>& in = judged_by_cell[key(p + (q - p) * (static_cast<double>(k) / steps), 0, 0, 0)];

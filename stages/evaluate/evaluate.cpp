@@ -438,6 +438,43 @@ FloorMetrics SampledFloor(const TriangleMesh& ref, const SurfaceSamples& ref_sam
   return f;
 }
 
+// The reference's branching curves, as `edges` over the returned vertices: its edges of 3+ faces and, with
+// --ref-nm-curves union, the curves where its triangles cross or touch (CrossingCurves). Sets
+// m.ref.nonmanifold_length (the edges of 3+ faces) and m.ref_crossing_length.
+TriangleMesh ReferenceBranchingCurves(const TriangleMesh& ref_welded, const EvaluateOptions& options, Metrics& m,
+                                      Monitor& monitor, std::vector<Edge>* edges) {
+  TriangleMesh curves;
+  curves.vertices = ref_welded.vertices;
+  *edges = NonManifoldEdges(ref_welded);
+  SampleEdges(curves, *edges, 0, &m.ref.nonmanifold_length);  // the length only
+  if (options.ref_nm_curves != "union") return curves;
+  const CurveSegments crossing = CrossingCurves(ref_welded, options.weld_tolerance, options.feature_angle_deg);
+  const int base = static_cast<int>(curves.vertices.size());
+  curves.vertices.insert(curves.vertices.end(), crossing.vertices.begin(), crossing.vertices.end());
+  for (const Edge& e : crossing.edges) {
+    edges->push_back({base + e[0], base + e[1]});
+    m.ref_crossing_length += (crossing.vertices[e[1]] - crossing.vertices[e[0]]).norm();
+  }
+  if (!crossing.edges.empty())
+    monitor.Info("reference: " + std::to_string(crossing.edges.size()) +
+                 Fmt(" crossing segments of length %.6g where its triangles cross or touch (non-manifold in the "
+                     "UDF)", m.ref_crossing_length));
+  return curves;
+}
+
+// How many of the mesh's non-manifold edges `nm_edges` have their midpoint farther than the mesh's median edge
+// length from every reference curve (all of them if the reference has none).
+size_t SpuriousEdges(const TriangleMesh& mesh, const std::vector<Edge>& nm_edges, const TriangleMesh& curves,
+                     const std::vector<Edge>& curve_edges, Monitor& monitor) {
+  if (curve_edges.empty() || nm_edges.empty()) return nm_edges.size();
+  std::vector<Vec3> mid;
+  for (const Edge& e : nm_edges) mid.push_back(0.5 * (mesh.vertices[e[0]] + mesh.vertices[e[1]]));
+  const double far = MedianEdgeLength(mesh);
+  size_t spurious = 0;
+  for (double d : DistancesToSegments(mid, curves.vertices, curve_edges, monitor)) spurious += d > far;
+  return spurious;
+}
+
 }  // namespace
 
 Metrics Evaluate(const TriangleMesh& mesh_in, const TriangleMesh& reference_in, const EvaluateOptions& options,
@@ -505,39 +542,12 @@ Metrics Evaluate(const TriangleMesh& mesh_in, const TriangleMesh& reference_in, 
     m.ecd_x1e2 = Chamfer(ref_edge, mesh_edge, monitor).SumOfMeans() * 1e2;
   }
 
-  // The reference's non-manifold curves: its edges of 3+ faces, and with "union" where its triangles cross.
-  TriangleMesh ref_curves;
-  ref_curves.vertices = ref_welded.vertices;
-  std::vector<Edge> ref_curve_edges = NonManifoldEdges(ref_welded);
-  for (const Edge& e : ref_curve_edges)
-    m.ref.nonmanifold_length += (ref_welded.vertices[e[1]] - ref_welded.vertices[e[0]]).norm();
-  if (options.ref_nm_curves == "union") {
-    const CurveSegments crossing = CrossingCurves(ref_welded, options.weld_tolerance, options.feature_angle_deg);
-    const int base = static_cast<int>(ref_curves.vertices.size());
-    ref_curves.vertices.insert(ref_curves.vertices.end(), crossing.vertices.begin(), crossing.vertices.end());
-    for (const Edge& e : crossing.edges) {
-      ref_curve_edges.push_back({base + e[0], base + e[1]});
-      m.ref_crossing_length += (crossing.vertices[e[1]] - crossing.vertices[e[0]]).norm();
-    }
-    if (!crossing.edges.empty())
-      monitor.Info("reference: " + std::to_string(crossing.edges.size()) +
-                   Fmt(" crossing segments of length %.6g where its triangles cross or touch (non-manifold in the "
-                       "UDF)", m.ref_crossing_length));
-  }
+  std::vector<Edge> ref_curve_edges;
+  const TriangleMesh ref_curves = ReferenceBranchingCurves(ref_welded, options, m, monitor, &ref_curve_edges);
   const std::vector<Vec3> ref_nm = SampleEdges(ref_curves, ref_curve_edges, options.nm_samples, nullptr);
-  const std::vector<Vec3> mesh_nm = SampleNonManifoldEdges(mesh_welded, options.nm_samples, &m.mesh.nonmanifold_length);
-  {
-    const std::vector<Edge> mesh_nm_edges = NonManifoldEdges(mesh_welded);
-    std::vector<Vec3> mid;
-    for (const Edge& e : mesh_nm_edges) mid.push_back(0.5 * (mesh_welded.vertices[e[0]] + mesh_welded.vertices[e[1]]));
-    if (ref_curve_edges.empty() || mid.empty()) {
-      m.spurious_nonmanifold_edges = mid.size();
-    } else {
-      const double far = MedianEdgeLength(mesh_welded);
-      for (double d : DistancesToSegments(mid, ref_curves.vertices, ref_curve_edges, monitor))
-        m.spurious_nonmanifold_edges += d > far;
-    }
-  }
+  const std::vector<Edge> mesh_nm_edges = NonManifoldEdges(mesh_welded);
+  const std::vector<Vec3> mesh_nm = SampleEdges(mesh_welded, mesh_nm_edges, options.nm_samples, &m.mesh.nonmanifold_length);
+  m.spurious_nonmanifold_edges = SpuriousEdges(mesh_welded, mesh_nm_edges, ref_curves, ref_curve_edges, monitor);
   if (ref_nm.empty() && mesh_nm.empty()) {
     m.nmcd_x1e3 = 0.0;
   } else if (ref_nm.empty() || mesh_nm.empty()) {

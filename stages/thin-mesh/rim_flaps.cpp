@@ -125,12 +125,10 @@ size_t RemoveRimFlaps(const Udf& udf, const std::vector<Vec3>& v, std::vector<Tr
 size_t RemoveFoldedFlaps(const std::vector<Vec3>& v, std::vector<Tri>& faces, double overlap_angle_deg) {
   const double min_cos = std::cos(overlap_angle_deg * M_PI / 180.0);
   LiveFaces live(faces);
-  auto away = [&](int f, const Edge& ab) {  // from edge ab towards face f's third vertex, unit
+  auto away = [&](int f, const Edge& ab) {  // from edge ab towards face f's third vertex
     const Tri& t = faces[static_cast<size_t>(f)];
     const Vec3 a = v[static_cast<size_t>(ab[0])], axis = (v[static_cast<size_t>(ab[1])] - a).normalized();
-    Vec3 d = v[static_cast<size_t>(t[0] + t[1] + t[2] - ab[0] - ab[1])] - a;
-    d -= d.dot(axis) * axis;
-    return Vec3(d.normalized());
+    return AcrossLine(a, axis, v[static_cast<size_t>(t[0] + t[1] + t[2] - ab[0] - ab[1])]);
   };
   size_t removed = 0;
   for (size_t f = 0; f < faces.size(); ++f) {

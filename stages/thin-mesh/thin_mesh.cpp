@@ -259,11 +259,9 @@ class Thinner {
       if (c == valence_[static_cast<size_t>(e)]) continue;  // inside the component
       const auto& ab = incidence_.edges[static_cast<size_t>(e)];
       const Vec3 a = p[static_cast<size_t>(ab[0])], axis = (p[static_cast<size_t>(ab[1])] - a).normalized();
-      auto away = [&](int f) {  // from the edge towards the face's third vertex, unit
+      auto away = [&](int f) {  // from the edge towards the face's third vertex
         const Tri& t = faces_[static_cast<size_t>(f)];
-        Vec3 d = p[static_cast<size_t>(t[0] + t[1] + t[2] - ab[0] - ab[1])] - a;
-        d -= d.dot(axis) * axis;
-        return Vec3(d.normalized());
+        return AcrossLine(a, axis, p[static_cast<size_t>(t[0] + t[1] + t[2] - ab[0] - ab[1])]);
       };
       for (int f : incidence_.faces[static_cast<size_t>(e)]) {
         if (!alive_[static_cast<size_t>(f)] || !in.count(f)) continue;
