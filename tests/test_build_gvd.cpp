@@ -411,6 +411,7 @@ TEST(BuildGvd, TheGraphDoesNotCrossAWallThinnerThanItsReach) {
   o.samples_per_seed = 30;
   o.eps_udf_rel = 0.05;
   o.eps_grad_both = 1.0;  // off
+  o.eps_grad_wall = 1.0;  // off
   const GvdResult off = BuildGvd(*udf, seeds, o, true, Monitor::Null());
   EXPECT_GT(EdgesThroughTheWall(off, t), 100u) << "the setting must put edges through the wall";
   o.eps_grad_both = BuildGvdOptions{}.eps_grad_both;
@@ -418,6 +419,42 @@ TEST(BuildGvd, TheGraphDoesNotCrossAWallThinnerThanItsReach) {
   EXPECT_EQ(EdgesThroughTheWall(on, t), 0u);
   EXPECT_GT(on.stats.edges_pruned_grad, off.stats.edges_pruned_grad);
   EXPECT_EQ(on.stats.unreached, 0u);  // each face stays connected to its own seeds
+}
+
+TEST(BuildGvd, TheGraphDoesNotJoinTwoParallelSheetsAtAnAngle) {
+  // A thinner wall (t = 0.025) under the same graph: its edges through the wall are up to about 2 t long,
+  // |cos| with the faces' normals down to 0.5 at both ends, which the both-ends test (0.8) lets through. Their
+  // ends' normals are parallel: the wall test (0.4) cuts them, and with them every dual triangle that joined
+  // a seed on the top face to one on the bottom face.
+  const double t = 0.025;
+  const auto udf = Plate(t);
+  const SeedCloud seeds = Seeds(*udf, 200);
+  BuildGvdOptions o;
+  o.samples_per_seed = 30;
+  o.eps_udf_rel = 0.05;
+  o.eps_grad_wall = 1.0;  // off
+  const GvdResult off = BuildGvd(*udf, seeds, o, true, Monitor::Null());
+  o.eps_grad_wall = BuildGvdOptions{}.eps_grad_wall;
+  const GvdResult on = BuildGvd(*udf, seeds, o, true, Monitor::Null());
+  auto across = [&](const GvdResult& r) {  // dual triangles with seeds on both faces, away from the rims
+    size_t n = 0;
+    for (const Tri& f : r.thick.faces) {
+      bool top = false, bottom = false, inner = true;
+      for (int v : f) {
+        const Vec3& p = r.thick.vertices[static_cast<size_t>(v)];
+        inner = inner && std::max(std::abs(p.x()), std::abs(p.y())) < 0.3;
+        top = top || p.z() > 0.25 * t;
+        bottom = bottom || p.z() < -0.25 * t;
+      }
+      n += inner && top && bottom;
+    }
+    return n;
+  };
+  EXPECT_GT(EdgesThroughTheWall(off, t), 100u) << "the setting must put edges through the wall";
+  EXPECT_GT(across(off), 10u) << "the setting must let the regions leak through the wall";
+  EXPECT_EQ(EdgesThroughTheWall(on, t), 0u);
+  EXPECT_EQ(across(on), 0u);
+  EXPECT_EQ(on.stats.unreached, 0u);
 }
 
 TEST(BuildGvd, SameResultWhateverTheThreadCount) {
@@ -445,6 +482,9 @@ TEST(BuildGvd, BadOptionsAndEmptySeedsAreRefused) {
   EXPECT_THROW(o.Check(), UsageError);
   o = BuildGvdOptions{};
   o.eps_grad_both = 1.5;
+  EXPECT_THROW(o.Check(), UsageError);
+  o = BuildGvdOptions{};
+  o.eps_grad_wall = 0;
   EXPECT_THROW(o.Check(), UsageError);
   const auto udf = MakeShape("sphere");
   EXPECT_THROW(BuildGvd(*udf, SeedCloud{}, BuildGvdOptions{}, false, Monitor::Null()), InputError);

@@ -81,11 +81,17 @@ void BuildGvdOptions::Check() const {
   if (!(eps_udf_rel > 0.0 && eps_udf_rel < 1.0)) throw UsageError("--eps-udf-rel must be in (0, 1)");
   if (!(eps_grad > 0.0 && eps_grad <= 1.0)) throw UsageError("--eps-grad must be in (0, 1]");
   if (!(eps_grad_both > 0.0 && eps_grad_both <= 1.0)) throw UsageError("--eps-grad-both must be in (0, 1]");
+  if (!(eps_grad_wall > 0.0 && eps_grad_wall <= 1.0)) throw UsageError("--eps-grad-wall must be in (0, 1]");
   if (curve_samples != "tangent" && curve_samples != "ball") throw UsageError("--curve-samples must be tangent or ball");
   CheckRelativeProjection(proj_tol_rel, proj_floor_rel, proj_max_iters, proj_twin_factor);
 }
 
 namespace {
+
+// --eps-grad-wall: two normals within this angle are one plane's (optimize-seeds' --crease-angle-deg default:
+// below it two planes are no crease).
+constexpr double kWallParallelDeg = 30.0;
+const double kWallParallelCos = std::cos(kWallParallelDeg * M_PI / 180.0);
 
 // Step 1b redraws the ball samples of these: seeds on a crease, a branching curve or a corner.
 bool IsCurveSeed(const SeedCloud& seeds, size_t s) { return seeds.rank[s] >= kRankEdge; }
@@ -371,7 +377,10 @@ Graph PrunedGraph(const Udf& udf, const std::vector<Vec3>& node, const std::vect
     const double len = dir.norm();
     if (len > 0.0) {
       const double ca = std::abs(node_n[a].dot(dir)) / len, cb = std::abs(node_n[b].dot(dir)) / len;
-      if (ca > options.eps_grad || cb > options.eps_grad || (ca > options.eps_grad_both && cb > options.eps_grad_both)) {
+      const bool wall = ca > options.eps_grad_wall && cb > options.eps_grad_wall &&
+                        std::abs(node_n[a].dot(node_n[b])) > kWallParallelCos;
+      if (ca > options.eps_grad || cb > options.eps_grad || (ca > options.eps_grad_both && cb > options.eps_grad_both) ||
+          wall) {
         ++pruned_grad;
         continue;
       }
@@ -403,9 +412,9 @@ Graph PrunedGraph(const Udf& udf, const std::vector<Vec3>& node, const std::vect
                 adj.begin() + static_cast<long>(offset[static_cast<size_t>(li) + 1]));
   }
   monitor.Info(Format("kNN graph (k=%d): %zu edges; pruned %zu with midpoint UDF > %.3g, %zu with |cos(edge, "
-                      "gradient)| > %.3g at an end or > %.3g at both; %zu left",
+                      "gradient)| > %.3g at an end, > %.3g at both or > %.3g at both with parallel gradients; %zu left",
                       kk, stats.edges_knn, pruned_udf, eps_udf, pruned_grad, options.eps_grad, options.eps_grad_both,
-                      offset[n] / 2));
+                      options.eps_grad_wall, offset[n] / 2));
   if (!with_edge_list) {  // only --graph writes them
     std::vector<std::pair<int, int>>().swap(edges);
     std::vector<char>().swap(keep);

@@ -45,6 +45,13 @@ struct BuildGvdOptions {
   /// on a crease or crossing carries the other face's normal, but the far end's normal is then across the
   /// edge, so creases and crossings keep their edges.
   double eps_grad_both = 0.8;
+  /// An edge is also pruned when |cos(edge, gradient)| exceeds this at both endpoints and the two gradients are
+  /// parallel within 30 degrees (--eps-grad-wall; 1: off): it joins two parallel sheets (the two faces of a
+  /// wall, the lips of a slit) more than this x its length apart. A chord of one smooth sheet rises from its
+  /// tangent plane by |cos| = length / (2 x radius) and its ends' normals turn by twice that angle, so the rule
+  /// leaves a sheet's own edges alone wherever the samples are finer than its radius; at a crease or a crossing
+  /// the normals are not parallel.
+  double eps_grad_wall = 0.4;
   /// --dual: "delaunay", the witnessed triples that are locally Delaunay (restricted_dual.h: one
   /// triangulation per junction); "paper", every witnessed triple (the paper's thick dual).
   std::string dual = "delaunay";
@@ -105,7 +112,7 @@ struct GvdResult {
 ///     onto the same corner point); so is a seed on top of an earlier seed (it gets no faces).
 ///  3. kNN graph (FLANN, exact kd-tree, k = knn) made undirected; an edge is pruned when
 ///     d(midpoint) > eps_udf_rel * diagonal, |cos(edge, n)| > eps_grad at either endpoint or > eps_grad_both
-///     at both.
+///     at both, or > eps_grad_wall at both with parallel gradients (a wall).
 ///  4. Multi-source Dijkstra with Euclidean edge lengths labels every node with its geodesically nearest seed;
 ///     unreachable nodes get label -1 and are counted.
 ///  5. For every node labelled i and every two distinct labels j, k (both != i, both >= 0) among its graph

@@ -33,6 +33,9 @@ int main(int argc, char** argv) {
   app.add_option("--eps-grad", options.eps_grad, "prune edges with |cos(edge, gradient)| above this at an end");
   app.add_option("--eps-grad-both", options.eps_grad_both,
                  "prune edges with |cos(edge, gradient)| above this at both ends (across a thin wall; 1: off)");
+  app.add_option("--eps-grad-wall", options.eps_grad_wall,
+                 "prune edges with |cos(edge, gradient)| above this at both ends whose gradients are parallel within "
+                 "30 degrees (from a sheet to the parallel one beside it; 1: off)");
   app.add_option("--dual", options.dual,
                  "delaunay: the witnessed triples that are locally Delaunay (one triangulation per junction); "
                  "paper: every witnessed triple (the paper's thick dual)")
