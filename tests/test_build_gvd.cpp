@@ -399,6 +399,14 @@ size_t EdgesThroughTheWall(const GvdResult& r, double t) {
   return through;
 }
 
+// A coarse graph (30 samples per seed) whose midpoint test (0.05 x diagonal) cannot see the plate's wall.
+BuildGvdOptions PlateGraphOptions() {
+  BuildGvdOptions o;
+  o.samples_per_seed = 30;
+  o.eps_udf_rel = 0.05;
+  return o;
+}
+
 TEST(BuildGvd, TheGraphDoesNotCrossAWallThinnerThanItsReach) {
   // The wall (t = 0.045) is thinner than twice eps_udf (here 0.05 x diagonal), so no midpoint rises far
   // enough for the UDF test, and the graph's longest edges (30 samples per seed) are about 1.25 t, so the
@@ -407,9 +415,7 @@ TEST(BuildGvd, TheGraphDoesNotCrossAWallThinnerThanItsReach) {
   const double t = 0.045;
   const auto udf = Plate(t);
   const SeedCloud seeds = Seeds(*udf, 200);
-  BuildGvdOptions o;
-  o.samples_per_seed = 30;
-  o.eps_udf_rel = 0.05;
+  BuildGvdOptions o = PlateGraphOptions();
   o.eps_grad_both = 1.0;  // off
   o.eps_grad_wall = 1.0;  // off
   const GvdResult off = BuildGvd(*udf, seeds, o, true, Monitor::Null());
@@ -429,9 +435,7 @@ TEST(BuildGvd, TheGraphDoesNotJoinTwoParallelSheetsAtAnAngle) {
   const double t = 0.025;
   const auto udf = Plate(t);
   const SeedCloud seeds = Seeds(*udf, 200);
-  BuildGvdOptions o;
-  o.samples_per_seed = 30;
-  o.eps_udf_rel = 0.05;
+  BuildGvdOptions o = PlateGraphOptions();
   o.eps_grad_wall = 1.0;  // off
   const GvdResult off = BuildGvd(*udf, seeds, o, true, Monitor::Null());
   o.eps_grad_wall = BuildGvdOptions{}.eps_grad_wall;
