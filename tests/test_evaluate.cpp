@@ -696,6 +696,68 @@ TEST(EvaluateCrossings, AMeshThatBranchesWhereTheReferencesPartsCrossIsNotSpurio
   EXPECT_EQ(Eval(off, ref, union_curves).spurious_nonmanifold_edges, 1u);
 }
 
+// An open cylinder of radius r along x (x in [0, 1]) with `facets` facets, lying on the plane z = lift: one
+// ring vertex at its lowest point (y = 0.5, z = lift), so with lift 0 it touches Square(n) along that line.
+TriangleMesh CylinderOnThePlane(int facets, double r, double lift) {
+  TriangleMesh m;
+  for (int end = 0; end < 2; ++end)
+    for (int k = 0; k < facets; ++k) {
+      const double a = -M_PI / 2 + 2 * M_PI * k / facets;
+      m.vertices.emplace_back(end, 0.5 + r * std::cos(a), lift + r + r * std::sin(a));
+    }
+  for (int k = 0; k < facets; ++k) {
+    const int a = k, b = (k + 1) % facets;
+    m.faces.push_back({a, b, facets + b});
+    m.faces.push_back({a, facets + b, facets + a});
+  }
+  return m;
+}
+
+TEST(EvaluateCrossings, APartLyingOnAnotherTangentiallyBranchesWhereNoTrianglesCross) {
+  // Its facets leave the plane at 7.5 degrees: no line where two triangles cross above the feature angle.
+  const TriangleMesh touching = Parts(Square(5), CylinderOnThePlane(24, 0.3, 0.0));
+  EXPECT_TRUE(CrossingCurves(touching, 1e-7, 30.0).edges.empty());
+  const std::vector<Vec3> at{Vec3(0.5, 0.5, 0.0), Vec3(0.3, 0.5, 0.0)}, along{Vec3(1, 0, 0), Vec3(1, 0, 0)};
+  // Cut across the line: the plane leaves the disc twice, the cylinder twice, and the two touch.
+  EXPECT_EQ(BranchesAcross(touching, at, along, 0.2, 0.002), std::vector<char>({1, 1}));
+  // Lifted by 0.01 (more than `join`) the parts are apart: two pieces of 2 exits, no branch.
+  const TriangleMesh apart = Parts(Square(5), CylinderOnThePlane(24, 0.3, 0.01));
+  EXPECT_EQ(BranchesAcross(apart, at, along, 0.2, 0.002), std::vector<char>({0, 0}));
+  // Manifold surfaces never branch: a plane, two parallel planes 0.05 apart, a cube's edge, a thin plate's rim.
+  EXPECT_EQ(BranchesAcross(Square(5), at, along, 0.2, 0.002), std::vector<char>({0, 0}));
+  EXPECT_EQ(BranchesAcross(Parts(Square(5), Square(5, 0.05)), at, along, 0.2, 0.002), std::vector<char>({0, 0}));
+  EXPECT_EQ(BranchesAcross(Cube(4), {Vec3(0.1, 0.5, 0.5)}, {Vec3(1, 0, 0)}, 0.2, 0.002), std::vector<char>({0}));
+  TriangleMesh plate = CubeSidesDisplaced(4, 0.0);
+  for (Vec3& p : plate.vertices) p.z() *= 0.05;  // 0.05 thick, welded at the rims by Evaluate only
+  EXPECT_EQ(BranchesAcross(WeldVertices(plate, 1e-9), {Vec3(0.1, 0.5, 0.0)}, {Vec3(1, 0, 0)}, 0.2, 0.002),
+            std::vector<char>({0}));
+}
+
+TEST(EvaluateCrossings, AMeshThatBranchesWhereTheReferencesPartsTouchTangentiallyIsNotSpurious) {
+  // The reference: a cylinder lying on a square, two parts. The mesh: the square with a fin standing on the
+  // line they touch along, one welded mesh (edges of 3 faces along the line), cells 0.05.
+  const TriangleMesh ref = Parts(Square(20), CylinderOnThePlane(24, 0.3, 0.0));
+  TriangleMesh mesh = Square(20);
+  const int base = static_cast<int>(mesh.vertices.size());
+  for (int i = 0; i <= 20; ++i) mesh.vertices.emplace_back(i / 20.0, 0.5, 0.05);
+  for (int i = 0; i < 20; ++i) {
+    const int a = 10 * 21 + i, b = a + 1;  // the square's vertices on y = 0.5
+    mesh.faces.push_back({a, b, base + i + 1});
+    mesh.faces.push_back({a, base + i + 1, base + i});
+  }
+  EvaluateOptions union_curves = Few();
+  const Metrics m = Eval(mesh, ref, union_curves);
+  EXPECT_EQ(m.mesh.topology.nonmanifold_edges, 20u);
+  EXPECT_EQ(m.ref_crossing_length, 0.0);
+  EXPECT_EQ(m.spurious_nonmanifold_edges, 0u);
+  EvaluateOptions edges_only = Few();
+  edges_only.ref_nm_curves = "edges";
+  EXPECT_EQ(Eval(mesh, ref, edges_only).spurious_nonmanifold_edges, 20u);
+  // The same mesh against the cylinder lifted off the square: every branching edge is spurious.
+  EXPECT_EQ(Eval(mesh, Parts(Square(20), CylinderOnThePlane(24, 0.3, 0.02)), union_curves).spurious_nonmanifold_edges,
+            20u);
+}
+
 // ---- errors, determinism, JSON ----
 
 TEST(EvaluateErrors, BadMeshesAndOptionsAreTypedErrors) {

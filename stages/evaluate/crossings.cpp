@@ -9,6 +9,8 @@
 #include <unordered_map>
 #include <utility>
 
+#include "common/union_find.h"
+
 namespace voroudf {
 namespace {
 
@@ -208,6 +210,137 @@ CurveSegments CrossingCurves(const TriangleMesh& mesh, double tolerance, double 
       if (h != f && !std::binary_search(near[static_cast<size_t>(f)].begin(), near[static_cast<size_t>(f)].end(), h))
         add(h);
     judge(p, q, DistinctDirections(dirs, same) >= 3);
+  }
+  return out;
+}
+
+namespace {
+
+using Vec2 = Eigen::Vector2d;
+
+// Distance between segments ab and cd in the plane (they do not cross: two triangles' cuts by one plane
+// cross only where the triangles do, and there the distance is 0 at the common point, which this finds).
+double SegmentDistance(const Vec2& a, const Vec2& b, const Vec2& c, const Vec2& d) {
+  auto to_segment = [](const Vec2& p, const Vec2& u, const Vec2& v) {
+    const Vec2 uv = v - u;
+    const double len2 = uv.squaredNorm();
+    const double s = len2 > 0 ? std::clamp((p - u).dot(uv) / len2, 0.0, 1.0) : 0.0;
+    return (u + s * uv - p).norm();
+  };
+  auto cross = [](const Vec2& u, const Vec2& v) { return u.x() * v.y() - u.y() * v.x(); };
+  const double d1 = cross(b - a, c - a), d2 = cross(b - a, d - a), d3 = cross(d - c, a - c), d4 = cross(d - c, b - c);
+  if (((d1 > 0 && d2 < 0) || (d1 < 0 && d2 > 0)) && ((d3 > 0 && d4 < 0) || (d3 < 0 && d4 > 0))) return 0.0;
+  return std::min({to_segment(a, c, d), to_segment(b, c, d), to_segment(c, a, b), to_segment(d, a, b)});
+}
+
+// Triangle t's cut by the plane through m with unit normal `axis`, in the plane's frame (e1, e2) around m,
+// clipped to the disc of radius r; false if it misses the disc or lies in the plane. `exits` gets the
+// angles at which the piece reaches the circle.
+bool CutInDisc(const TriangleMesh& mesh, const Tri& t, const Vec3& m, const Vec3& axis, const Vec3& e1, const Vec3& e2,
+               double r, std::array<Vec2, 2>* piece, std::vector<double>* exits) {
+  std::array<double, 3> side;
+  std::array<Vec3, 3> v;
+  for (int k = 0; k < 3; ++k) {
+    v[static_cast<size_t>(k)] = mesh.vertices[static_cast<size_t>(t[static_cast<size_t>(k)])] - m;
+    side[static_cast<size_t>(k)] = v[static_cast<size_t>(k)].dot(axis);
+  }
+  const double scale = std::max({v[0].norm(), v[1].norm(), v[2].norm()}), eps = 1e-12 * scale;
+  if (std::abs(side[0]) <= eps && std::abs(side[1]) <= eps && std::abs(side[2]) <= eps) return false;  // in the plane
+  std::vector<Vec3> hits;
+  for (int k = 0; k < 3; ++k) {
+    const size_t i = static_cast<size_t>(k), j = static_cast<size_t>((k + 1) % 3);
+    if (std::abs(side[i]) <= eps) {
+      hits.push_back(v[i]);
+    } else if ((side[i] > eps && side[j] < -eps) || (side[i] < -eps && side[j] > eps)) {
+      hits.push_back(v[i] + (v[j] - v[i]) * (side[i] / (side[i] - side[j])));
+    }
+  }
+  if (hits.size() < 2) return false;
+  const Vec2 p(hits[0].dot(e1), hits[0].dot(e2)), q(hits[1].dot(e1), hits[1].dot(e2));
+  // |p + u (q - p)| <= r for u in [u0, u1] within [0, 1].
+  const Vec2 d = q - p;
+  const double a = d.squaredNorm(), b = p.dot(d), c = p.squaredNorm() - r * r;
+  if (!(a > 0)) return false;
+  const double disc = b * b - a * c;
+  if (disc <= 0) return false;
+  const double u0 = (-b - std::sqrt(disc)) / a, u1 = (-b + std::sqrt(disc)) / a;
+  const double lo = std::max(0.0, u0), hi = std::min(1.0, u1);
+  if (!(lo < hi)) return false;
+  (*piece)[0] = p + lo * d;
+  (*piece)[1] = p + hi * d;
+  if (u0 >= 0.0) exits->push_back(std::atan2((*piece)[0].y(), (*piece)[0].x()));
+  if (u1 <= 1.0) exits->push_back(std::atan2((*piece)[1].y(), (*piece)[1].x()));
+  return true;
+}
+
+// How many exits (angles) lie more than `min_gap` apart around the circle.
+size_t DistinctExits(std::vector<double> angles, double min_gap) {
+  if (angles.empty()) return 0;
+  std::sort(angles.begin(), angles.end());
+  size_t distinct = 1;
+  for (size_t k = 1; k < angles.size(); ++k) distinct += angles[k] - angles[k - 1] > min_gap;
+  if (distinct > 1 && angles.front() + 2 * M_PI - angles.back() <= min_gap) --distinct;  // around through ±π
+  return distinct;
+}
+
+}  // namespace
+
+std::vector<char> BranchesAcross(const TriangleMesh& mesh, const std::vector<Vec3>& points,
+                                 const std::vector<Vec3>& directions, double radius, double join) {
+  std::vector<char> out(points.size(), 0);
+  if (points.empty()) return out;
+  std::vector<FaceBox> faces, queries;
+  for (size_t f = 0; f < mesh.faces.size(); ++f) {
+    const Tri& t = mesh.faces[f];
+    double lo[3], hi[3];
+    for (int k = 0; k < 3; ++k) {
+      lo[k] = std::min({mesh.vertices[t[0]][k], mesh.vertices[t[1]][k], mesh.vertices[t[2]][k]});
+      hi[k] = std::max({mesh.vertices[t[0]][k], mesh.vertices[t[1]][k], mesh.vertices[t[2]][k]});
+    }
+    faces.emplace_back(lo, hi, static_cast<int>(f));
+  }
+  for (size_t i = 0; i < points.size(); ++i) {
+    double lo[3], hi[3];
+    for (int k = 0; k < 3; ++k) {
+      lo[k] = points[i][k] - radius;
+      hi[k] = points[i][k] + radius;
+    }
+    queries.emplace_back(lo, hi, static_cast<int>(i));
+  }
+  std::vector<std::vector<int>> near(points.size());
+  CGAL::box_intersection_d(faces.begin(), faces.end(), queries.begin(), queries.end(),
+                           [&](const FaceBox& f, const FaceBox& q) { near[static_cast<size_t>(q.info())].push_back(f.info()); });
+  const double min_gap = join / radius;  // exits closer than `join` on the circle are one
+#pragma omp parallel for schedule(dynamic, 4)
+  for (long li = 0; li < static_cast<long>(points.size()); ++li) {
+    const size_t i = static_cast<size_t>(li);
+    std::vector<int>& cand = near[i];
+    std::sort(cand.begin(), cand.end());  // the box intersection's order is not fixed
+    const Vec3 axis = directions[i].normalized();
+    const Vec3 e1 = (std::abs(axis.x()) < 0.9 ? Vec3::UnitX() : Vec3::UnitY()).cross(axis).normalized();
+    const Vec3 e2 = axis.cross(e1);
+    std::vector<std::array<Vec2, 2>> pieces;
+    std::vector<std::vector<double>> exits;
+    for (int f : cand) {
+      std::array<Vec2, 2> piece;
+      std::vector<double> piece_exits;
+      if (!CutInDisc(mesh, mesh.faces[static_cast<size_t>(f)], points[i], axis, e1, e2, radius, &piece, &piece_exits))
+        continue;
+      pieces.push_back(piece);
+      exits.push_back(std::move(piece_exits));
+    }
+    UnionFind sets(pieces.size());
+    for (size_t a = 0; a < pieces.size(); ++a)
+      for (size_t b = a + 1; b < pieces.size(); ++b)
+        if (SegmentDistance(pieces[a][0], pieces[a][1], pieces[b][0], pieces[b][1]) <= join)
+          sets.Union(static_cast<int>(a), static_cast<int>(b));
+    std::vector<std::vector<double>> by_set(pieces.size());
+    for (size_t a = 0; a < pieces.size(); ++a) {
+      auto& into = by_set[static_cast<size_t>(sets.Find(static_cast<int>(a)))];
+      into.insert(into.end(), exits[a].begin(), exits[a].end());
+    }
+    for (const auto& angles : by_set)
+      if (DistinctExits(angles, min_gap) >= 3) out[i] = 1;
   }
   return out;
 }

@@ -34,4 +34,18 @@ struct CurveSegments {
 };
 CurveSegments CrossingCurves(const TriangleMesh& mesh, double tolerance, double min_angle_deg);
 
+/// Whether the union of `mesh`'s triangles branches across each line through points[i] along directions[i]:
+/// its cross-section by the plane through the point normal to the line, within the disc of radius `radius`,
+/// has a connected piece that leaves the disc at 3 or more points. Pieces closer than `join` are one (parts
+/// that touch or coincide), and so are exits closer than `join` (coincident faces of two parts). The
+/// cross-section of a manifold surface is a set of curves, each piece of which leaves the disc twice or
+/// not at all; a rim inside the disc leaves once. So 3+ exits mean a wall on a plate, a face leaving another
+/// tangentially (where the coincident faces of two nested parts part), parts crossing (4) or touching:
+/// the branching that CrossingCurves, which looks for lines where two triangles cross at an angle, cannot
+/// see. Two sheets closer than the radius but apart are two pieces of 2 exits each. Candidate triangles
+/// from CGAL's box intersection.
+/// \pre points and directions (non-zero) of the same size; radius > join > 0
+std::vector<char> BranchesAcross(const TriangleMesh& mesh, const std::vector<Vec3>& points,
+                                 const std::vector<Vec3>& directions, double radius, double join);
+
 }  // namespace voroudf

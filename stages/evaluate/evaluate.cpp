@@ -463,15 +463,34 @@ TriangleMesh ReferenceBranchingCurves(const TriangleMesh& ref_welded, const Eval
 }
 
 // How many of the mesh's non-manifold edges `nm_edges` have their midpoint farther than the mesh's median edge
-// length from every reference curve (all of them if the reference has none).
-size_t SpuriousEdges(const TriangleMesh& mesh, const std::vector<Edge>& nm_edges, const TriangleMesh& curves,
-                     const std::vector<Edge>& curve_edges, Monitor& monitor) {
-  if (curve_edges.empty() || nm_edges.empty()) return nm_edges.size();
+// length h from every reference curve (all of them if the reference has none) and, with --ref-nm-curves
+// union, no branching of the reference's union across them within 2 h (BranchesAcross: where parts touch
+// tangentially or coincide, there is no line where two triangles cross to find).
+size_t SpuriousEdges(const TriangleMesh& mesh, const std::vector<Edge>& nm_edges, const TriangleMesh& ref_welded,
+                     const TriangleMesh& curves, const std::vector<Edge>& curve_edges, const EvaluateOptions& options,
+                     Monitor& monitor) {
+  if (nm_edges.empty()) return 0;
   std::vector<Vec3> mid;
   for (const Edge& e : nm_edges) mid.push_back(0.5 * (mesh.vertices[e[0]] + mesh.vertices[e[1]]));
   const double far = MedianEdgeLength(mesh);
-  size_t spurious = 0;
-  for (double d : DistancesToSegments(mid, curves.vertices, curve_edges, monitor)) spurious += d > far;
+  std::vector<char> off(nm_edges.size(), 1);
+  if (!curve_edges.empty()) {
+    const std::vector<double> d = DistancesToSegments(mid, curves.vertices, curve_edges, monitor);
+    for (size_t k = 0; k < d.size(); ++k) off[k] = d[k] > far;
+  }
+  if (options.ref_nm_curves != "union") return static_cast<size_t>(std::count(off.begin(), off.end(), 1));
+  std::vector<Vec3> at, along;
+  for (size_t k = 0; k < nm_edges.size(); ++k)
+    if (off[k]) {
+      at.push_back(mid[k]);
+      along.push_back(mesh.vertices[nm_edges[k][1]] - mesh.vertices[nm_edges[k][0]]);
+    }
+  const std::vector<char> branch = BranchesAcross(ref_welded, at, along, 2.0 * far, 0.01 * far);
+  const size_t spurious = static_cast<size_t>(std::count(branch.begin(), branch.end(), 0));
+  if (spurious < at.size())
+    monitor.Info(std::to_string(at.size() - spurious) +
+                 " non-manifold edges away from the reference's crossing curves lie where its parts touch "
+                 "without crossing (BranchesAcross): not spurious");
   return spurious;
 }
 
@@ -547,7 +566,8 @@ Metrics Evaluate(const TriangleMesh& mesh_in, const TriangleMesh& reference_in, 
   const std::vector<Vec3> ref_nm = SampleEdges(ref_curves, ref_curve_edges, options.nm_samples, nullptr);
   const std::vector<Edge> mesh_nm_edges = NonManifoldEdges(mesh_welded);
   const std::vector<Vec3> mesh_nm = SampleEdges(mesh_welded, mesh_nm_edges, options.nm_samples, &m.mesh.nonmanifold_length);
-  m.spurious_nonmanifold_edges = SpuriousEdges(mesh_welded, mesh_nm_edges, ref_curves, ref_curve_edges, monitor);
+  m.spurious_nonmanifold_edges =
+      SpuriousEdges(mesh_welded, mesh_nm_edges, ref_welded, ref_curves, ref_curve_edges, options, monitor);
   if (ref_nm.empty() && mesh_nm.empty()) {
     m.nmcd_x1e3 = 0.0;
   } else if (ref_nm.empty() || mesh_nm.empty()) {
