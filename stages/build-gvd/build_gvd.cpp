@@ -279,22 +279,22 @@ struct Graph {
   std::vector<int> adj;
 };
 
-Graph PrunedGraph(const Udf& udf, const std::vector<Vec3>& node, const std::vector<double>& node_d,
-                  const std::vector<Vec3>& node_n, const BuildGvdOptions& options, double diag, bool with_edge_list,
-                  BuildGvdStats& stats, Monitor& monitor) {
+// Step 3a: every undirected edge of the kNN graph (k = knn_wanted, `kk` the k found), each once.
+std::vector<std::pair<int, int>> UndirectedKnnEdges(const std::vector<Vec3>& node, int knn_wanted, int* kk,
+                                                     Monitor& monitor) {
   const size_t n = node.size();
-  int kk = 0;
-  std::vector<int> knn = KNearestAmong(node, options.knn, &kk, monitor, "kNN graph");
+  std::vector<int> knn = KNearestAmong(node, knn_wanted, kk, monitor, "kNN graph");
+  const int k_found = *kk;
   monitor.Debug("kNN queries done");
   // Undirected edges, each once: (i, j) from i's list when j > i, or when i is not in j's list. No global
   // sort (it took longer than the queries); the order is by i, then by distance, whatever the threads.
   auto in_list = [&](size_t owner, int x) {
-    const int* row = knn.data() + owner * static_cast<size_t>(kk);
-    return std::find(row, row + kk, x) != row + kk;
+    const int* row = knn.data() + owner * static_cast<size_t>(k_found);
+    return std::find(row, row + k_found, x) != row + k_found;
   };
   // Which of i's list entries give i an edge, as bits, found once: the list search is most of the listing's
   // time.
-  const size_t words = (static_cast<size_t>(kk) + 63) / 64;
+  const size_t words = (static_cast<size_t>(k_found) + 63) / 64;
   std::vector<uint64_t> owns(n * words, 0);
   std::vector<size_t> edge_begin(n + 1, 0);
 #pragma omp parallel for schedule(static)
@@ -302,8 +302,8 @@ Graph PrunedGraph(const Udf& udf, const std::vector<Vec3>& node, const std::vect
     const size_t i = static_cast<size_t>(li);
     uint64_t* bits = owns.data() + i * words;
     size_t count = 0;
-    for (int j = 0; j < kk; ++j) {
-      const int o = knn[i * static_cast<size_t>(kk) + static_cast<size_t>(j)];
+    for (int j = 0; j < k_found; ++j) {
+      const int o = knn[i * static_cast<size_t>(k_found) + static_cast<size_t>(j)];
       if (o >= 0 && (o > static_cast<int>(i) || !in_list(static_cast<size_t>(o), static_cast<int>(i)))) {
         bits[j / 64] |= uint64_t{1} << (j % 64);
         ++count;
@@ -317,16 +317,23 @@ Graph PrunedGraph(const Udf& udf, const std::vector<Vec3>& node, const std::vect
   for (long li = 0; li < static_cast<long>(n); ++li) {
     const size_t i = static_cast<size_t>(li);
     size_t at = edge_begin[i];
-    for (int j = 0; j < kk; ++j) {
+    for (int j = 0; j < k_found; ++j) {
       if (!(owns[i * words + static_cast<size_t>(j) / 64] >> (j % 64) & 1)) continue;
-      const int o = knn[i * static_cast<size_t>(kk) + static_cast<size_t>(j)];
+      const int o = knn[i * static_cast<size_t>(k_found) + static_cast<size_t>(j)];
       edges[at++] = {std::min(static_cast<int>(i), o), std::max(static_cast<int>(i), o)};
     }
   }
   std::vector<uint64_t>().swap(owns);
-  stats.edges_knn = edges.size();
   std::vector<int>().swap(knn);  // the memory peak: at 50k seeds the lists and the edges are 0.8 GB each
   monitor.Debug("undirected edges listed");
+  return edges;
+}
+
+// Step 3b: which edges stay: those that leave the surface (midpoint test) or jump between sheets
+// (gradient tests) are pruned; the counts go to stats.
+std::vector<char> KeptEdges(const Udf& udf, const std::vector<Vec3>& node, const std::vector<double>& node_d,
+                            const std::vector<Vec3>& node_n, const std::vector<std::pair<int, int>>& edges,
+                            const BuildGvdOptions& options, double diag, BuildGvdStats& stats, Monitor& monitor) {
   // The midpoint test measures the rise of d above the edge's ends, d(mid) - max(d(a), d(b)), so that a field
   // with a floor (nodes at a kink's bottom with d = e > 0, common/projection.h) is judged like an exact one
   // (nodes at d ~ 0). It needs a query only where it can fail: a UDF is 1-Lipschitz, so d(mid) ≤ min(d(a),
@@ -390,7 +397,12 @@ Graph PrunedGraph(const Udf& udf, const std::vector<Vec3>& node, const std::vect
   std::vector<char>().swap(too_far);
   stats.edges_pruned_udf = pruned_udf;
   stats.edges_pruned_grad = pruned_grad;
-  // Adjacency in CSR form, each neighbour list sorted.
+  return keep;
+}
+
+// Step 3c: the kept edges as adjacency lists in CSR form, each neighbour list sorted.
+void Adjacency(size_t n, const std::vector<std::pair<int, int>>& edges, const std::vector<char>& keep,
+               std::vector<size_t>* offset_out, std::vector<int>* adj_out) {
   std::vector<size_t> offset(n + 1, 0);
   for (size_t e = 0; e < edges.size(); ++e)
     if (keep[e]) {
@@ -411,6 +423,23 @@ Graph PrunedGraph(const Udf& udf, const std::vector<Vec3>& node, const std::vect
       std::sort(adj.begin() + static_cast<long>(offset[static_cast<size_t>(li)]),
                 adj.begin() + static_cast<long>(offset[static_cast<size_t>(li) + 1]));
   }
+  *offset_out = std::move(offset);
+  *adj_out = std::move(adj);
+}
+
+Graph PrunedGraph(const Udf& udf, const std::vector<Vec3>& node, const std::vector<double>& node_d,
+                  const std::vector<Vec3>& node_n, const BuildGvdOptions& options, double diag, bool with_edge_list,
+                  BuildGvdStats& stats, Monitor& monitor) {
+  const size_t n = node.size();
+  int kk = 0;
+  std::vector<std::pair<int, int>> edges = UndirectedKnnEdges(node, options.knn, &kk, monitor);
+  stats.edges_knn = edges.size();
+  std::vector<char> keep = KeptEdges(udf, node, node_d, node_n, edges, options, diag, stats, monitor);
+  std::vector<size_t> offset;
+  std::vector<int> adj;
+  Adjacency(n, edges, keep, &offset, &adj);
+  const double eps_udf = options.eps_udf_rel * diag;
+  const size_t pruned_udf = stats.edges_pruned_udf, pruned_grad = stats.edges_pruned_grad;
   monitor.Info(Format("kNN graph (k=%d): %zu edges; pruned %zu with midpoint UDF > %.3g, %zu with |cos(edge, "
                       "gradient)| > %.3g at an end, > %.3g at both or > %.3g at both with parallel gradients; %zu left",
                       kk, stats.edges_knn, pruned_udf, eps_udf, pruned_grad, options.eps_grad, options.eps_grad_both,
@@ -459,21 +488,20 @@ std::vector<Tri> WitnessedTriples(const Graph& g, const std::vector<int>& label)
   return faces;
 }
 
-}  // namespace
+// Steps 1-2: the dense samples projected onto the zero set and the seeds, as graph nodes with their UDF
+// values and gradients (MakeNodes' order); the counts go to stats.
+struct Nodes {
+  std::vector<Vec3> position;
+  std::vector<int> seed;  // the seed a node is, or -1 for a sample
+  std::vector<double> d;
+  std::vector<Vec3> n;
+};
 
-GvdResult BuildGvd(const Udf& udf, const SeedCloud& seeds, const BuildGvdOptions& options, bool with_graph,
-                   Monitor& monitor) {
-  options.Check();
-  const size_t num_seeds = seeds.size();
-  if (num_seeds == 0) throw InputError("the seeds file has no seeds");
-  if (num_seeds > static_cast<size_t>(std::numeric_limits<int>::max() / 4))
-    throw InputError("too many seeds for 32-bit mesh indices");
+Nodes DenseNodes(const Udf& udf, const SeedCloud& seeds, const BuildGvdOptions& options, BuildGvdStats& stats,
+                 Monitor& monitor) {
   const Box box = udf.Domain();
   const double diag = box.Diagonal();
-  GvdResult result;
-  BuildGvdStats& stats = result.stats;
-
-  // 1. Dense samples, projected onto the zero set.
+  const size_t num_seeds = seeds.size();
   size_t in_space = 0;
   TangentDraws tangent;
   std::vector<Vec3> samples = DrawSamples(seeds, box, options, &in_space, &tangent);
@@ -490,10 +518,11 @@ GvdResult BuildGvd(const Udf& udf, const SeedCloud& seeds, const BuildGvdOptions
     stats.samples_redrawn = RedrawInTangentDiscs(udf, seeds, tangent, in_space, proj, samples, projected, monitor);
 
   // 2. Nodes.
-  std::vector<Vec3> node;
-  std::vector<int> node_seed;
-  std::vector<double> node_d;
-  std::vector<Vec3> node_n;
+  Nodes nodes;
+  std::vector<Vec3>& node = nodes.position;
+  std::vector<int>& node_seed = nodes.seed;
+  std::vector<double>& node_d = nodes.d;
+  std::vector<Vec3>& node_n = nodes.n;
   MakeNodes(seeds, samples, projected, box, stats, &node, &node_seed, &node_d, &node_n);
   const size_t n = node.size();
   stats.nodes = n;
@@ -521,24 +550,15 @@ GvdResult BuildGvd(const Udf& udf, const SeedCloud& seeds, const BuildGvdOptions
       }
   }
   monitor.Debug("node gradients evaluated");
+  return nodes;
+}
 
-  // 3-4. Graph and sweep.
-  const Graph graph = PrunedGraph(udf, node, node_d, node_n, options, diag, with_graph, stats, monitor);
-  std::vector<double> dist;
-  std::vector<int> label;
-  // Ranges of about 32 k nodes: each range's values (1.2 MB) stay in a core's cache while it is swept, and
-  // the ranges run in parallel; fandisk's sweep went from 0.5 s to 0.14 s on two threads (0.22 s on one).
-  // A function of the graph alone, so the result does not depend on the thread count.
-  const size_t parts = std::max<size_t>(1, n / kSweepRangeNodes);
-  GeodesicSweep(graph.offset, graph.adj, node, node_seed, parts, &dist, &label, monitor);
-  monitor.Debug("geodesic sweep done");
-  for (size_t i = 0; i < n; ++i) stats.unreached += label[i] < 0 ? 1 : 0;
-  if (stats.unreached > 0)
-    monitor.Warn(Format("%zu of %zu samples are not reached from any seed (label -1)", stats.unreached, n));
-
-  // 5-6. Witnessed triples; with the default dual, the locally Delaunay ones.
-  std::vector<Tri>& faces = result.thick.faces;
-  faces = WitnessedTriples(graph, label);
+// Steps 5-6: the witnessed triples; with --dual delaunay the locally Delaunay ones, with --chain-links
+// less those that jump a feature chain.
+std::vector<Tri> DualTriangles(const Graph& graph, const std::vector<int>& label, const std::vector<Vec3>& node,
+                               const SeedCloud& seeds, const BuildGvdOptions& options, Monitor& monitor) {
+  const size_t num_seeds = seeds.size();
+  std::vector<Tri> faces = WitnessedTriples(graph, label);
   monitor.Debug("witnessed triples listed");
   if (options.dual == "delaunay") {
     RestrictedDualStats rd;
@@ -561,6 +581,44 @@ GvdResult BuildGvd(const Udf& udf, const SeedCloud& seeds, const BuildGvdOptions
                           cl.links, cl.dropped, cl.jumps, cl.added));
     }
   }
+  return faces;
+}
+
+}  // namespace
+
+GvdResult BuildGvd(const Udf& udf, const SeedCloud& seeds, const BuildGvdOptions& options, bool with_graph,
+                   Monitor& monitor) {
+  options.Check();
+  const size_t num_seeds = seeds.size();
+  if (num_seeds == 0) throw InputError("the seeds file has no seeds");
+  if (num_seeds > static_cast<size_t>(std::numeric_limits<int>::max() / 4))
+    throw InputError("too many seeds for 32-bit mesh indices");
+  const double diag = udf.Domain().Diagonal();
+  GvdResult result;
+  BuildGvdStats& stats = result.stats;
+
+  // 1-2. Dense samples projected onto the zero set, and the seeds: the graph's nodes.
+  Nodes nodes = DenseNodes(udf, seeds, options, stats, monitor);
+  std::vector<Vec3>& node = nodes.position;
+  const size_t n = node.size();
+
+  // 3-4. Graph and sweep.
+  const Graph graph = PrunedGraph(udf, node, nodes.d, nodes.n, options, diag, with_graph, stats, monitor);
+  std::vector<double> dist;
+  std::vector<int> label;
+  // Ranges of about 32 k nodes: each range's values (1.2 MB) stay in a core's cache while it is swept, and
+  // the ranges run in parallel; fandisk's sweep went from 0.5 s to 0.14 s on two threads (0.22 s on one).
+  // A function of the graph alone, so the result does not depend on the thread count.
+  const size_t parts = std::max<size_t>(1, n / kSweepRangeNodes);
+  GeodesicSweep(graph.offset, graph.adj, node, nodes.seed, parts, &dist, &label, monitor);
+  monitor.Debug("geodesic sweep done");
+  for (size_t i = 0; i < n; ++i) stats.unreached += label[i] < 0 ? 1 : 0;
+  if (stats.unreached > 0)
+    monitor.Warn(Format("%zu of %zu samples are not reached from any seed (label -1)", stats.unreached, n));
+
+  // 5-6. The dual's triangles.
+  std::vector<Tri>& faces = result.thick.faces;
+  faces = DualTriangles(graph, label, node, seeds, options, monitor);
   stats.triangles = faces.size();
   result.thick.vertices = seeds.position;
   monitor.Info(Format("%zu dual triangles over %zu seeds", faces.size(), num_seeds));
