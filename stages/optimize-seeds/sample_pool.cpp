@@ -118,6 +118,107 @@ void SamplePool::Grow(Bucket& b, double mark) const {
   b.begin.swap(begin);
 }
 
+// The buckets every wanted cell's ball meets, once (the balls do not change between a Select's passes):
+// looked up in parallel, the missing ones then created serially in order of first use.
+std::vector<std::vector<uint32_t>> SamplePool::TouchedBuckets(const std::vector<Cell>& cells,
+                                                              const std::vector<char>& pending) {
+  const size_t n = cells.size();
+  std::vector<std::vector<uint32_t>> touched(n);
+  std::vector<std::vector<std::pair<int64_t, Vec3>>> missing(n);
+#pragma omp parallel for schedule(dynamic, 64)
+  for (long li = 0; li < static_cast<long>(n); ++li) {
+    const size_t i = static_cast<size_t>(li);
+    if (!pending[i]) continue;
+    ForBucketsInBall(cells[i].centre, cells[i].radius, h_, [&](int64_t key, const Vec3& origin) {
+      const auto it = index_.find(key);
+      if (it != index_.end())
+        touched[i].push_back(it->second);
+      else
+        missing[i].emplace_back(key, origin);
+    });
+  }
+  for (size_t i = 0; i < n; ++i)
+    for (const auto& [key, origin] : missing[i]) {
+      if (buckets_.size() >= (size_t{1} << (64 - kBucketShift))) throw NumericalError("sample pool: over 2^24 cubes");
+      auto [it, inserted] = index_.try_emplace(key, static_cast<uint32_t>(buckets_.size()));
+      if (inserted)
+        buckets_.push_back({origin, Rng(seed_, static_cast<uint64_t>(key)), 0.0f, 0.0,
+                            {}, std::vector<uint32_t>(static_cast<size_t>(layers_ * kSubCubes) + 1, 0)});
+      touched[i].push_back(it->second);
+    }
+  return touched;
+}
+
+// Appends to `found` (mark, id) of the points of layer `layer` with mark below t in the buckets `touched`
+// that lie in the cell (its ball, then its half-spaces); returns how many points it looked at.
+uint64_t SamplePool::Scan(const Cell& cell, const std::vector<uint32_t>& touched, double t, int layer,
+                          std::vector<std::pair<double, PointId>>& found) const {
+  const double r2 = cell.radius * cell.radius;
+  uint64_t seen = 0;
+  for (uint32_t b : touched) {
+    const Vec3 origin = buckets_[b].origin;
+    if (OutsideSomeHalfSpace(cell, origin, h_)) continue;
+    const double sub_size = h_ / kSplit, slack = 1e-6 * h_;
+    for (int sub = 0; sub < kSubCubes; ++sub) {
+      const Vec3 sub_origin = origin + sub_size * Vec3(sub / (kSplit * kSplit), (sub / kSplit) % kSplit, sub % kSplit);
+      // Skipped only when no point of it can pass the tests below (with room for the float offsets'
+      // rounding): the selection is the same as without the split.
+      if (BoxGapSquared(cell.centre, sub_origin - Vec3::Constant(slack), sub_size + 2.0 * slack) > r2 * (1.0 + 1e-9))
+        continue;
+      const size_t part = static_cast<size_t>(layer * kSubCubes + sub);
+      const Entry_* entries = buckets_[b].Part(part);
+      const size_t size = buckets_[b].Size(part);
+      for (size_t e = 0; e < size && entries[e].mark < t; ++e) {
+        ++seen;
+        // As Point(id) − centre, so that callers can check membership to the last bit.
+        const Vec3 q = (origin + Vec3(entries[e].offset[0], entries[e].offset[1], entries[e].offset[2])) - cell.centre;
+        if (q.squaredNorm() > r2) continue;
+        bool inside = true;
+        for (size_t k = 0; k < cell.offsets.size() && inside; ++k) inside = cell.offsets[k].dot(q) <= cell.half_sq[k];
+        if (inside)
+          found.emplace_back(entries[e].mark, (static_cast<PointId>(b) << kBucketShift) |
+                                                  (static_cast<PointId>(part) << kIndexBits) | e);
+      }
+    }
+  }
+  return seen;
+}
+
+// fill_ from this Select's cells: a low quantile of the share of its ball each filled, so that most cells
+// find their M in the next Select's first pass.
+void SamplePool::UpdateFill(const std::vector<double>& fill) {
+  std::vector<double> fills;
+  for (double f : fill)
+    if (f > 0.0) fills.push_back(f);
+  if (!fills.empty()) {
+    const size_t q = fills.size() / 5;
+    std::nth_element(fills.begin(), fills.begin() + static_cast<long>(q), fills.end());
+    fill_ = std::clamp(fills[q], 0.02, 1.0);
+  }
+}
+
+// Every bucket an open cell needs complete to a higher mark is grown to the largest such mark.
+void SamplePool::GrowForCells(const std::vector<size_t>& open, const std::vector<std::vector<uint32_t>>& touched,
+                              const std::vector<double>& mark) {
+  std::vector<uint32_t> short_buckets;  // those not yet complete to the mark a cell wants
+  for (size_t i : open)
+    for (uint32_t b : touched[i]) {
+      Bucket& bucket = buckets_[b];
+      if (static_cast<double>(bucket.complete) >= mark[i]) continue;
+      // A part's index has kIndexBits; a mark that high (several GB in one cube) means seeds nearly coincide.
+      if (!(mark[i] < 0.5 * static_cast<double>(kIndexMask)))
+        throw NumericalError("sample pool: a cell needs over 2^27 points in one cube (seeds nearly coincide)");
+      if (bucket.wanted == 0.0) short_buckets.push_back(b);
+      bucket.wanted = std::max(bucket.wanted, mark[i]);
+    }
+#pragma omp parallel for schedule(dynamic, 64)
+  for (long k = 0; k < static_cast<long>(short_buckets.size()); ++k) {
+    Bucket& b = buckets_[short_buckets[static_cast<size_t>(k)]];
+    Grow(b, b.wanted);
+    b.wanted = 0.0;
+  }
+}
+
 std::vector<std::vector<SamplePool::PointId>> SamplePool::Select(const std::vector<Cell>& cells,
                                                                  const std::vector<char>& wanted, size_t m,
                                                                  double max_cube_points,
@@ -152,55 +253,13 @@ std::vector<std::vector<SamplePool::PointId>> SamplePool::Select(const std::vect
   std::vector<size_t> by_place;
   by_place.reserve(centres.size());
   for (size_t k : MortonOrder(centres, BoundingBox(centres))) by_place.push_back(pending_index[k]);
-  // The buckets every wanted cell's ball meets, once (the balls do not change between passes): looked up in
-  // parallel, the missing ones then created serially in order of first use.
-  std::vector<std::vector<uint32_t>> touched(n);
-  std::vector<std::vector<std::pair<int64_t, Vec3>>> missing(n);
-#pragma omp parallel for schedule(dynamic, 64)
-  for (long li = 0; li < static_cast<long>(n); ++li) {
-    const size_t i = static_cast<size_t>(li);
-    if (!pending[i]) continue;
-    ForBucketsInBall(cells[i].centre, cells[i].radius, h_, [&](int64_t key, const Vec3& origin) {
-      const auto it = index_.find(key);
-      if (it != index_.end())
-        touched[i].push_back(it->second);
-      else
-        missing[i].emplace_back(key, origin);
-    });
-  }
-  for (size_t i = 0; i < n; ++i)
-    for (const auto& [key, origin] : missing[i]) {
-      if (buckets_.size() >= (size_t{1} << (64 - kBucketShift))) throw NumericalError("sample pool: over 2^24 cubes");
-      auto [it, inserted] = index_.try_emplace(key, static_cast<uint32_t>(buckets_.size()));
-      if (inserted)
-        buckets_.push_back({origin, Rng(seed_, static_cast<uint64_t>(key)), 0.0f, 0.0,
-                            {}, std::vector<uint32_t>(static_cast<size_t>(layers_ * kSubCubes) + 1, 0)});
-      touched[i].push_back(it->second);
-    }
+  const std::vector<std::vector<uint32_t>> touched = TouchedBuckets(cells, pending);
   for (;;) {
     std::vector<size_t> open;
     for (size_t i : by_place)
       if (pending[i]) open.push_back(i);
     if (open.empty()) break;
-    // Every bucket an open cell needs complete to a higher mark is grown to the largest such mark.
-    std::vector<uint32_t> short_buckets;  // those not yet complete to the mark a cell wants
-    for (size_t i : open)
-      for (uint32_t b : touched[i]) {
-        Bucket& bucket = buckets_[b];
-        if (static_cast<double>(bucket.complete) >= mark[i]) continue;
-        // A part's index has kIndexBits; a mark that high (several GB in one cube) means seeds nearly coincide.
-        if (!(mark[i] < 0.5 * static_cast<double>(kIndexMask)))
-          throw NumericalError("sample pool: a cell needs over 2^27 points in one cube (seeds nearly coincide)");
-        if (bucket.wanted == 0.0) short_buckets.push_back(b);
-        bucket.wanted = std::max(bucket.wanted, mark[i]);
-      }
-#pragma omp parallel for schedule(dynamic, 64)
-    for (long k = 0; k < static_cast<long>(short_buckets.size()); ++k) {
-      Bucket& b = buckets_[short_buckets[static_cast<size_t>(k)]];
-      Grow(b, b.wanted);
-      b.wanted = 0.0;
-    }
-
+    GrowForCells(open, touched, mark);
 #pragma omp parallel
     {
       std::vector<std::pair<double, PointId>> found;
@@ -209,34 +268,8 @@ std::vector<std::vector<SamplePool::PointId>> SamplePool::Select(const std::vect
         const size_t i = open[static_cast<size_t>(li)];
         const Cell& cell = cells[i];
         const double r2 = cell.radius * cell.radius, t = mark[i];
-        uint64_t seen = 0;
         found.clear();
-        for (uint32_t b : touched[i]) {
-          const Vec3 origin = buckets_[b].origin;
-          if (OutsideSomeHalfSpace(cell, origin, h_)) continue;
-          const double sub_size = h_ / kSplit, slack = 1e-6 * h_;
-          for (int sub = 0; sub < kSubCubes; ++sub) {
-            const Vec3 sub_origin = origin + sub_size * Vec3(sub / (kSplit * kSplit), (sub / kSplit) % kSplit, sub % kSplit);
-            // Skipped only when no point of it can pass the tests below (with room for the float offsets'
-            // rounding): the selection is the same as without the split.
-            if (BoxGapSquared(cell.centre, sub_origin - Vec3::Constant(slack), sub_size + 2.0 * slack) > r2 * (1.0 + 1e-9))
-              continue;
-            const size_t part = static_cast<size_t>(layer * kSubCubes + sub);
-            const Entry_* entries = buckets_[b].Part(part);
-            const size_t size = buckets_[b].Size(part);
-            for (size_t e = 0; e < size && entries[e].mark < t; ++e) {
-              ++seen;
-              // As Point(id) − centre, so that callers can check membership to the last bit.
-              const Vec3 q = (origin + Vec3(entries[e].offset[0], entries[e].offset[1], entries[e].offset[2])) - cell.centre;
-              if (q.squaredNorm() > r2) continue;
-              bool inside = true;
-              for (size_t k = 0; k < cell.offsets.size() && inside; ++k) inside = cell.offsets[k].dot(q) <= cell.half_sq[k];
-              if (inside)
-                found.emplace_back(entries[e].mark, (static_cast<PointId>(b) << kBucketShift) |
-                                                        (static_cast<PointId>(part) << kIndexBits) | e);
-            }
-          }
-        }
+        const uint64_t seen = Scan(cell, touched[i], t, layer, found);
         if (found.size() >= m || t >= cap[i]) {
           const size_t keep = std::min(m, found.size());
           std::nth_element(found.begin(), found.begin() + static_cast<long>(keep) - (keep > 0), found.end());
@@ -256,15 +289,7 @@ std::vector<std::vector<SamplePool::PointId>> SamplePool::Select(const std::vect
       }
     }
   }
-  std::vector<double> fills;
-  for (double f : fill)
-    if (f > 0.0) fills.push_back(f);
-  if (!fills.empty()) {
-    // A low quantile: most cells then find their M in the first pass.
-    const size_t q = fills.size() / 5;
-    std::nth_element(fills.begin(), fills.begin() + static_cast<long>(q), fills.end());
-    fill_ = std::clamp(fills[q], 0.02, 1.0);
-  }
+  UpdateFill(fill);
   return out;
 }
 

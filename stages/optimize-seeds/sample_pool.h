@@ -109,6 +109,12 @@ class SamplePool {
     return b.entries[b.begin[(id >> kIndexBits) & kPartMask] + (id & kIndexMask)];
   }
   void Grow(Bucket& b, double mark) const;  // b complete up to `mark`
+  std::vector<std::vector<uint32_t>> TouchedBuckets(const std::vector<Cell>& cells, const std::vector<char>& pending);
+  uint64_t Scan(const Cell& cell, const std::vector<uint32_t>& touched, double t, int layer,
+                std::vector<std::pair<double, PointId>>& found) const;
+  void UpdateFill(const std::vector<double>& fill);
+  void GrowForCells(const std::vector<size_t>& open, const std::vector<std::vector<uint32_t>>& touched,
+                    const std::vector<double>& mark);
   static bool OutsideSomeHalfSpace(const Cell& cell, const Vec3& lo, double size);
 
   uint64_t seed_;
