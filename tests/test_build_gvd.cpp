@@ -461,6 +461,61 @@ TEST(BuildGvd, TheGraphDoesNotJoinTwoParallelSheetsAtAnAngle) {
   EXPECT_EQ(on.stats.unreached, 0u);
 }
 
+// The plane z = 0 seen through a field error, as a noisy or learned field shows it: where x < 0 a floor (d =
+// |z| + a), where x >= 0 two zero sheets at z = +-a with a flat valley of height a/5 between them (no ridge
+// of height a, so the projection's twin merge leaves them). With `floor` false, x < 0 has the two sheets too:
+// an exact field of two real sheets 2a apart, no floor anywhere.
+class TwinsBesideAFloor final : public Udf {
+ public:
+  TwinsBesideAFloor(double a, bool floor) : a_(a), floor_(floor) {}
+  void EvaluateChunk(const Vec3* p, size_t count, double* d, Vec3* g) const override {
+    for (size_t i = 0; i < count; ++i) {
+      const double z = p[i].z(), up = z < 0 ? -1.0 : 1.0;
+      if (floor_ && p[i].x() < 0) {
+        d[i] = std::abs(z) + a_;
+        g[i] = Vec3(0, 0, up);
+      } else {
+        d[i] = std::abs(z) >= a_ ? std::abs(z) - a_ : std::min(a_ - std::abs(z), 0.2 * a_);
+        g[i] = Vec3(0, 0, std::abs(z) >= a_ ? up : -up);
+      }
+    }
+  }
+  Box Domain() const override { return {Vec3::Constant(-1), Vec3::Constant(1)}; }
+  std::string Describe() const override { return "twins beside a floor"; }
+
+ private:
+  double a_;
+  bool floor_;
+};
+
+// Graph edges from z = +a to z = -a (x in [0.1, 0.9], away from the seam at x = 0) that the wall test alone
+// could cut: |cos(edge, gradient)| above eps_grad_wall at both ends.
+size_t EdgesAcrossTheTwins(const GvdResult& r, double a, double wall) {
+  size_t n = 0;
+  for (const auto& e : r.samples.edges) {
+    const Vec3& p = r.samples.position[static_cast<size_t>(e[0])];
+    const Vec3& q = r.samples.position[static_cast<size_t>(e[1])];
+    const bool far = std::min(p.x(), q.x()) > 0.1 && std::max(p.x(), q.x()) < 0.9;
+    const bool across = std::abs(p.z() + q.z()) < 0.1 * a && std::abs(p.z() - q.z()) > 1.9 * a;
+    n += far && across && 2 * a / (q - p).norm() > wall;
+  }
+  return n;
+}
+
+TEST(BuildGvd, SheetsCloserThanTheFieldsTwinSeparationAreNoWall) {
+  // Where the field has floors, the projection measures its error (twin separation 2.5 a here): two sheets
+  // closer than that are one surface seen through it, and the graph keeps its edges between them. On an
+  // exact field (no floor, twin separation 0) the same two sheets are a wall, and the wall test cuts them.
+  const double a = 2e-3;
+  BuildGvdOptions o;
+  o.samples_per_seed = 30;
+  const TwinsBesideAFloor noisy(a, true), exact(a, false);
+  const GvdResult kept = BuildGvd(noisy, Seeds(noisy, 300), o, true, Monitor::Null());
+  EXPECT_GT(EdgesAcrossTheTwins(kept, a, o.eps_grad_wall), 50u);
+  const GvdResult cut = BuildGvd(exact, Seeds(exact, 300), o, true, Monitor::Null());
+  EXPECT_EQ(EdgesAcrossTheTwins(cut, a, o.eps_grad_wall), 0u);
+}
+
 TEST(BuildGvd, SameResultWhateverTheThreadCount) {
   const auto udf = MakeShape("three-discs");
   const SeedCloud seeds = Seeds(*udf, 300);

@@ -333,7 +333,8 @@ std::vector<std::pair<int, int>> UndirectedKnnEdges(const std::vector<Vec3>& nod
 // (gradient tests) are pruned; the counts go to stats.
 std::vector<char> KeptEdges(const Udf& udf, const std::vector<Vec3>& node, const std::vector<double>& node_d,
                             const std::vector<Vec3>& node_n, const std::vector<std::pair<int, int>>& edges,
-                            const BuildGvdOptions& options, double diag, BuildGvdStats& stats, Monitor& monitor) {
+                            const BuildGvdOptions& options, double diag, double twin_within, BuildGvdStats& stats,
+                            Monitor& monitor) {
   // The midpoint test measures the rise of d above the edge's ends, d(mid) - max(d(a), d(b)), so that a field
   // with a floor (nodes at a kink's bottom with d = e > 0, common/projection.h) is judged like an exact one
   // (nodes at d ~ 0). It needs a query only where it can fail: a UDF is 1-Lipschitz, so d(mid) ≤ min(d(a),
@@ -384,8 +385,10 @@ std::vector<char> KeptEdges(const Udf& udf, const std::vector<Vec3>& node, const
     const double len = dir.norm();
     if (len > 0.0) {
       const double ca = std::abs(node_n[a].dot(dir)) / len, cb = std::abs(node_n[b].dot(dir)) / len;
+      // Two sheets closer than the field's twin separation are one surface seen through its error (the
+      // zero sheets of |d + e| either side of it): no wall between them.
       const bool wall = ca > options.eps_grad_wall && cb > options.eps_grad_wall &&
-                        std::abs(node_n[a].dot(node_n[b])) > kWallParallelCos;
+                        std::abs(node_n[a].dot(node_n[b])) > kWallParallelCos && ca * len > twin_within;
       if (ca > options.eps_grad || cb > options.eps_grad || (ca > options.eps_grad_both && cb > options.eps_grad_both) ||
           wall) {
         ++pruned_grad;
@@ -428,13 +431,13 @@ void Adjacency(size_t n, const std::vector<std::pair<int, int>>& edges, const st
 }
 
 Graph PrunedGraph(const Udf& udf, const std::vector<Vec3>& node, const std::vector<double>& node_d,
-                  const std::vector<Vec3>& node_n, const BuildGvdOptions& options, double diag, bool with_edge_list,
-                  BuildGvdStats& stats, Monitor& monitor) {
+                  const std::vector<Vec3>& node_n, const BuildGvdOptions& options, double diag, double twin_within,
+                  bool with_edge_list, BuildGvdStats& stats, Monitor& monitor) {
   const size_t n = node.size();
   int kk = 0;
   std::vector<std::pair<int, int>> edges = UndirectedKnnEdges(node, options.knn, &kk, monitor);
   stats.edges_knn = edges.size();
-  std::vector<char> keep = KeptEdges(udf, node, node_d, node_n, edges, options, diag, stats, monitor);
+  std::vector<char> keep = KeptEdges(udf, node, node_d, node_n, edges, options, diag, twin_within, stats, monitor);
   std::vector<size_t> offset;
   std::vector<int> adj;
   Adjacency(n, edges, keep, &offset, &adj);
@@ -495,6 +498,7 @@ struct Nodes {
   std::vector<int> seed;  // the seed a node is, or -1 for a sample
   std::vector<double> d;
   std::vector<Vec3> n;
+  double twin_within = 0.0;  // the projection's twin separation: sheets closer are one surface (0: exact field)
 };
 
 Nodes DenseNodes(const Udf& udf, const SeedCloud& seeds, const BuildGvdOptions& options, BuildGvdStats& stats,
@@ -524,6 +528,7 @@ Nodes DenseNodes(const Udf& udf, const SeedCloud& seeds, const BuildGvdOptions& 
   std::vector<double>& node_d = nodes.d;
   std::vector<Vec3>& node_n = nodes.n;
   MakeNodes(seeds, samples, projected, box, stats, &node, &node_seed, &node_d, &node_n);
+  nodes.twin_within = proj.twin_within;
   const size_t n = node.size();
   stats.nodes = n;
   if (stats.seeds_duplicate > 0)
@@ -603,7 +608,8 @@ GvdResult BuildGvd(const Udf& udf, const SeedCloud& seeds, const BuildGvdOptions
   const size_t n = node.size();
 
   // 3-4. Graph and sweep.
-  const Graph graph = PrunedGraph(udf, node, nodes.d, nodes.n, options, diag, with_graph, stats, monitor);
+  const Graph graph =
+      PrunedGraph(udf, node, nodes.d, nodes.n, options, diag, nodes.twin_within, with_graph, stats, monitor);
   std::vector<double> dist;
   std::vector<int> label;
   // Ranges of about 32 k nodes: each range's values (1.2 MB) stay in a core's cache while it is swept, and

@@ -50,7 +50,8 @@ struct BuildGvdOptions {
   /// wall, the lips of a slit) more than this x its length apart. A chord of one smooth sheet rises from its
   /// tangent plane by |cos| = length / (2 x radius) and its ends' normals turn by twice that angle, so the rule
   /// leaves a sheet's own edges alone wherever the samples are finer than its radius; at a crease or a crossing
-  /// the normals are not parallel.
+  /// the normals are not parallel. Sheets closer than the projection's twin separation (a noisy field's error;
+  /// 0 on an exact field) are one surface, not a wall: the test skips them.
   double eps_grad_wall = 0.4;
   /// --dual: "delaunay", the witnessed triples that are locally Delaunay (restricted_dual.h: one
   /// triangulation per junction); "paper", every witnessed triple (the paper's thick dual).
