@@ -12,19 +12,21 @@
 namespace voroudf {
 namespace {
 
-using KdIndex = flann::Index<flann::L2_Simple<double>>;
-
-// flann::Matrix only points at memory it does not own: the rows live as long as the index.
+// flann::Matrix only points at memory it does not own: the rows live as long as the index. Scalar: double
+// for evaluate's distances; float for the kNN graphs, whose queries wait on memory (half the bytes per point;
+// coordinates in a unit box keep 7 digits, far below any sample spacing).
+template <typename Scalar>
 struct KdTree {
-  std::vector<double> rows;
-  std::unique_ptr<KdIndex> index;
+  using Index = flann::Index<flann::L2_Simple<Scalar>>;
+  std::vector<Scalar> rows;
+  std::unique_ptr<Index> index;
 
   KdTree(const std::vector<Vec3>& points, int leaf_size) : rows(3 * points.size()) {
     for (size_t i = 0; i < points.size(); ++i)
-      for (int k = 0; k < 3; ++k) rows[3 * i + static_cast<size_t>(k)] = points[i][k];
+      for (int k = 0; k < 3; ++k) rows[3 * i + static_cast<size_t>(k)] = static_cast<Scalar>(points[i][k]);
     // A single kd-tree with exact search: randomised forests would make results depend on rand().
-    index = std::make_unique<KdIndex>(flann::Matrix<double>(rows.data(), points.size(), 3),
-                                      flann::KDTreeSingleIndexParams(leaf_size));
+    index = std::make_unique<Index>(flann::Matrix<Scalar>(rows.data(), points.size(), 3),
+                                    flann::KDTreeSingleIndexParams(leaf_size));
     index->buildIndex();
   }
 };
@@ -44,19 +46,19 @@ std::vector<int> KNearestAmong(const std::vector<Vec3>& points, int k, int* k_ou
   *k_out = kk;
   std::vector<int> result(n * static_cast<size_t>(kk), -1);
   if (kk == 0) return result;
-  const KdTree tree(points, 12);
+  const KdTree<float> tree(points, 12);
   // Blocks bound the memory of FLANN's result matrices; k + 1 because every point finds itself.
   const size_t block = 32768;
   const int kq = kk + 1;
   std::vector<size_t> idx(block * static_cast<size_t>(kq));
-  std::vector<double> dist(block * static_cast<size_t>(kq));
+  std::vector<float> dist(block * static_cast<size_t>(kq));
   const flann::SearchParams params = ExactSearch();
   Task task(monitor, task_name, n);
   for (size_t begin = 0; begin < n; begin += block) {
     const size_t m = std::min(block, n - begin);
-    flann::Matrix<double> queries(const_cast<double*>(tree.rows.data()) + 3 * begin, m, 3);
+    flann::Matrix<float> queries(const_cast<float*>(tree.rows.data()) + 3 * begin, m, 3);
     flann::Matrix<size_t> mi(idx.data(), m, static_cast<size_t>(kq));
-    flann::Matrix<double> md(dist.data(), m, static_cast<size_t>(kq));
+    flann::Matrix<float> md(dist.data(), m, static_cast<size_t>(kq));
     tree.index->knnSearch(queries, mi, md, static_cast<size_t>(kq), params);
     for (size_t q = 0; q < m; ++q) {
       const size_t self = begin + q;
@@ -76,7 +78,7 @@ std::vector<int> NearestIndices(const std::vector<Vec3>& data, const std::vector
   if (data.empty()) throw Error("NearestIndices: no data point");
   std::vector<int> nearest(queries.size(), -1);
   if (queries.empty()) return nearest;
-  const KdTree tree(data, 10);
+  const KdTree<double> tree(data, 10);
   flann::SearchParams params = ExactSearch();
   params.sorted = false;
   const std::vector<size_t> order = MortonOrder(queries, BoundingBox(queries));
