@@ -292,15 +292,18 @@ inline void ChildSqDistances(const NodeT& nd, double px, double py, double pz, d
 #endif
 }
 
+// The answer for a query that is not a point: NaN distance and point, no face.
+TriangleBvh::Hit NoHit() {
+  TriangleBvh::Hit none;
+  none.sq_distance = std::numeric_limits<double>::quiet_NaN();
+  none.point = Vec3::Constant(std::numeric_limits<double>::quiet_NaN());
+  return none;
+}
+
 }  // namespace
 
 TriangleBvh::Hit TriangleBvh::Closest(const Vec3& p, int hint) const {
-  if (!p.allFinite()) {  // NaN would slip through the SIMD max(., 0) and visit every box
-    Hit none;
-    none.sq_distance = std::numeric_limits<double>::quiet_NaN();
-    none.point = Vec3::Constant(std::numeric_limits<double>::quiet_NaN());
-    return none;
-  }
+  if (!p.allFinite()) return NoHit();  // NaN would slip through the SIMD max(., 0) and visit every box
   const double px = p.x(), py = p.y(), pz = p.z();
   double best = std::numeric_limits<double>::infinity();
   // Boxes and planes are pruned only beyond `bound` = (sqrt(best) + tie_slack_)^2, so that every triangle
@@ -393,12 +396,7 @@ TriangleBvh::Hit TriangleBvh::Closest(const Vec3& p, int hint) const {
     }
     if (node < 0) break;
   }
-  Hit hit;
-  hit.sq_distance = best;
-  hit.point = Vec3(bx, by, bz);
-  hit.face = best_slot >= 0 ? face_of_[best_slot] : -1;
-  hit.slot = best_slot;
-  return hit;
+  return Hit{best, Vec3(bx, by, bz), best_slot >= 0 ? face_of_[best_slot] : -1, best_slot};
 }
 
 Vec3 TriangleBvh::FaceNormal(int face) const { return normal_[face]; }
