@@ -16,6 +16,17 @@ namespace {
 
 using FaceBox = CGAL::Box_intersection_d::Box_with_info_d<double, 3, int>;
 
+// Triangle f's bounding box grown by `pad` on every side, labelled f.
+FaceBox BoxOfFace(const TriangleMesh& mesh, size_t f, double pad) {
+  const Tri& t = mesh.faces[f];
+  double lo[3], hi[3];
+  for (int k = 0; k < 3; ++k) {
+    lo[k] = std::min({mesh.vertices[t[0]][k], mesh.vertices[t[1]][k], mesh.vertices[t[2]][k]}) - pad;
+    hi[k] = std::max({mesh.vertices[t[0]][k], mesh.vertices[t[1]][k], mesh.vertices[t[2]][k]}) + pad;
+  }
+  return FaceBox(lo, hi, static_cast<int>(f));
+}
+
 
 // The interval [t0, t1] of the line o + t dir (in the plane of triangle a, b, c with unit normal n) that
 // lies in the triangle, within `tolerance`; false if none.
@@ -126,14 +137,9 @@ CurveSegments CrossingCurves(const TriangleMesh& mesh, double tolerance, double 
   boxes.reserve(nf);
   bound.reserve(nf);
   for (size_t f = 0; f < nf; ++f) {
-    const Tri& t = mesh.faces[f];
-    double lo[3], hi[3];
-    for (int k = 0; k < 3; ++k) {
-      lo[k] = std::min({mesh.vertices[t[0]][k], mesh.vertices[t[1]][k], mesh.vertices[t[2]][k]}) - tolerance;
-      hi[k] = std::max({mesh.vertices[t[0]][k], mesh.vertices[t[1]][k], mesh.vertices[t[2]][k]}) + tolerance;
-    }
-    boxes.emplace_back(lo, hi, static_cast<int>(f));
-    bound.emplace_back(Vec3(lo[0], lo[1], lo[2]), Vec3(hi[0], hi[1], hi[2]));
+    const FaceBox& box = boxes.emplace_back(BoxOfFace(mesh, f, tolerance));
+    bound.emplace_back(Vec3(box.min_coord(0), box.min_coord(1), box.min_coord(2)),
+                       Vec3(box.max_coord(0), box.max_coord(1), box.max_coord(2)));
   }
   // Every pair of triangles whose boxes meet: the candidates, and the triangles near a candidate's segment
   // (a triangle through the segment's midpoint meets both triangles, so its box is paired with theirs).
@@ -290,15 +296,7 @@ std::vector<char> BranchesAcross(const TriangleMesh& mesh, const std::vector<Vec
   std::vector<char> out(points.size(), 0);
   if (points.empty()) return out;
   std::vector<FaceBox> faces, queries;
-  for (size_t f = 0; f < mesh.faces.size(); ++f) {
-    const Tri& t = mesh.faces[f];
-    double lo[3], hi[3];
-    for (int k = 0; k < 3; ++k) {
-      lo[k] = std::min({mesh.vertices[t[0]][k], mesh.vertices[t[1]][k], mesh.vertices[t[2]][k]});
-      hi[k] = std::max({mesh.vertices[t[0]][k], mesh.vertices[t[1]][k], mesh.vertices[t[2]][k]});
-    }
-    faces.emplace_back(lo, hi, static_cast<int>(f));
-  }
+  for (size_t f = 0; f < mesh.faces.size(); ++f) faces.push_back(BoxOfFace(mesh, f, 0.0));
   for (size_t i = 0; i < points.size(); ++i) {
     double lo[3], hi[3];
     for (int k = 0; k < 3; ++k) {
