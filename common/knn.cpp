@@ -5,6 +5,8 @@
 
 #include <algorithm>
 #include <memory>
+#include <numeric>
+#include <queue>
 
 #include "common/errors.h"
 #include "common/morton.h"
@@ -98,6 +100,62 @@ std::vector<int> NearestIndices(const std::vector<Vec3>& data, const std::vector
     monitor.Advance(end - begin);
   }
   return nearest;
+}
+
+std::vector<size_t> FarthestPointSubset(const std::vector<Vec3>& points, size_t count, double* covering_radius) {
+  const size_t n = points.size();
+  if (covering_radius) *covering_radius = 0.0;
+  std::vector<size_t> taken;
+  if (count >= n) {
+    taken.resize(n);
+    std::iota(taken.begin(), taken.end(), size_t{0});
+    return taken;
+  }
+  if (count == 0) return taken;
+  // FLANN has no incremental farthest-point query; the greedy loop is written here on its radius search.
+  // d2[i]: squared distance from point i to the nearest taken point. A max-heap with lazy deletion holds
+  // (d2, i) entries; an entry whose value is no longer d2[i] is stale and skipped.
+  std::vector<double> d2(n);
+  for (size_t i = 0; i < n; ++i) d2[i] = (points[i] - points[0]).squaredNorm();
+  using Entry = std::pair<double, size_t>;
+  const auto lower = [](const Entry& a, const Entry& b) {  // larger distance first, then the lower index
+    return a.first < b.first || (a.first == b.first && a.second > b.second);
+  };
+  std::vector<Entry> entries(n);
+  for (size_t i = 0; i < n; ++i) entries[i] = {d2[i], i};
+  std::priority_queue<Entry, std::vector<Entry>, decltype(lower)> heap(lower, std::move(entries));
+  const KdTree<double> tree(points, 10);
+  flann::SearchParams params(flann::FLANN_CHECKS_UNLIMITED, 0.0f, false);
+  params.cores = 1;
+  std::vector<std::vector<size_t>> found(1);
+  std::vector<std::vector<double>> found_d2(1);
+  taken.push_back(0);
+  double last = 0.0;
+  while (taken.size() < count && !heap.empty()) {
+    const auto [d, i] = heap.top();
+    heap.pop();
+    if (d != d2[i] || (d == 0.0 && i == 0)) continue;  // stale, or the first point itself
+    taken.push_back(i);
+    last = d;
+    d2[i] = 0.0;
+    // Only points nearer to i than to every taken point change, and all of them lie within sqrt(d) of i:
+    // d is the largest d2 left.
+    Vec3 q = points[i];
+    flann::Matrix<double> qm(q.data(), 1, 3);
+    // FLANN takes the squared radius as a float: widened, so that rounding never drops a point.
+    tree.index->radiusSearch(qm, found, found_d2, static_cast<float>(d * (1.0 + 1e-5)), params);
+    for (size_t k = 0; k < found[0].size(); ++k) {
+      const size_t j = found[0][k];
+      const double dj = (points[j] - q).squaredNorm();  // recomputed: the same value however FLANN rounds
+      if (dj < d2[j]) {
+        d2[j] = dj;
+        heap.push({dj, j});
+      }
+    }
+  }
+  if (covering_radius) *covering_radius = std::sqrt(last);
+  std::sort(taken.begin(), taken.end());
+  return taken;
 }
 
 }  // namespace voroudf

@@ -21,4 +21,13 @@ std::vector<int> KNearestAmong(const std::vector<Vec3>& points, int k, int* k_ou
 /// result. \pre `data` is not empty
 std::vector<int> NearestIndices(const std::vector<Vec3>& data, const std::vector<Vec3>& queries, Monitor& monitor);
 
+/// Farthest-point sampling (Eldar, Lindenbaum, Porat & Zeevi 1997, "The farthest point strategy for
+/// progressive image sampling"): starting from points[0], repeatedly takes the point farthest from all taken
+/// so far (ties: the lower index), until `count` are taken. Returns their indices in increasing order and, in
+/// `*covering_radius` if given, the distance at which the last one was taken: every point lies within it of a
+/// taken one, and no two taken points are closer (so the subset is at most twice as sparse as the best
+/// covering of that size, Gonzalez 1985). Exact (a kd-tree bounds each update to the current radius); depends
+/// only on the points. All indices if count >= points.size().
+std::vector<size_t> FarthestPointSubset(const std::vector<Vec3>& points, size_t count, double* covering_radius = nullptr);
+
 }  // namespace voroudf

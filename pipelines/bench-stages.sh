@@ -12,6 +12,7 @@
 #   INPUTS="A;B"  UDF sources to run, separated by ';' (default: the five above)
 #   REPS=N   runs per input (3)    THREADS=N   --threads of every stage (0)
 #   OPTIMIZE_ARGS="..."  extra options of optimize-seeds, e.g. "--cell-samples fresh" (the paper's sampling)
+#   SAMPLE_ARGS="..."    extra options of sample-seeds, e.g. "--spread-pool 1" (the paper's uniform start)
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 bin=${1:-$root/build/bin}
@@ -20,6 +21,7 @@ count=${COUNT:-2500}
 reps=${REPS:-3}
 threads=${THREADS:-0}
 read -r -a optimize_args <<< "${OPTIMIZE_ARGS:-}"
+read -r -a sample_args <<< "${SAMPLE_ARGS:-}"
 for p in sample-seeds optimize-seeds build-gvd thin-mesh; do
   [ -x "$bin/$p" ] || { echo "bench-stages: $bin/$p is not built" >&2; exit 2; }
 done
@@ -55,7 +57,7 @@ for udf in "${inputs[@]}"; do
   : > "$work/total"
   for ((r = 1; r <= reps; ++r)); do
     common=(--udf "$udf" --threads "$threads")
-    timed "$work/sample-seeds" "$bin/sample-seeds" "${common[@]}" --count "$count" --seed 1 -o "$work/seeds0.ply"
+    timed "$work/sample-seeds" "$bin/sample-seeds" "${common[@]}" "${sample_args[@]}" --count "$count" --seed 1 -o "$work/seeds0.ply"
     timed "$work/optimize-seeds" "$bin/optimize-seeds" "${common[@]}" "${optimize_args[@]}" -i "$work/seeds0.ply" -o "$work/seeds.ply"
     timed "$work/build-gvd" "$bin/build-gvd" "${common[@]}" -i "$work/seeds.ply" -o "$work/thick.ply"
     timed "$work/thin-mesh" "$bin/thin-mesh" "${common[@]}" -i "$work/thick.ply" -o "$work/mesh.ply"

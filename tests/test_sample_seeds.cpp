@@ -5,6 +5,8 @@
 #include <cmath>
 
 #include "common/errors.h"
+#include "common/knn.h"
+#include "common/rng.h"
 #include "common/shapes.h"
 #include "formats/seeds_io.h"
 #include "stages/sample-seeds/sample_seeds.h"
@@ -63,6 +65,7 @@ TEST(SampleSeeds, TheBandKeepsSeedsOffTheSharpEdges) {
   const auto udf = MakeShape("cube");
   SampleSeedsOptions options;
   options.count = 2000;
+  options.spread_pool = 1;  // the draws themselves (the farthest-point choice takes extreme points first)
   options.band_rel = 0.0;  // the whole box: every draw in an edge's outer wedge lands on the edge
   const double whole_box = FractionOnCubeEdges(SampleSeeds(*udf, options, Monitor::Null()));
   options.band_rel = 0.01;
@@ -91,6 +94,7 @@ TEST(SampleSeeds, DuplicatesAreDropped) {
   SampleSeedsOptions options;
   options.count = 3000;
   options.band_rel = 0.0;
+  options.spread_pool = 1;  // the farthest-point choice would take one point per corner
   const SeedCloud seeds = SampleSeeds(*udf, options, Monitor::Null());
   EXPECT_LT(seeds.size(), options.count);
   const double radius = options.dedup_rel * udf->Domain().Diagonal();
@@ -134,6 +138,7 @@ TEST(ThinParts, TheBoostMovesSeedsToTheRingAndKeepsTheCount) {
     for (const Vec3& p : s.position) n += OnRing(p);
     return static_cast<double>(n) / static_cast<double>(s.size());
   };
+  options.spread_pool = 1;
   const SeedCloud uniform = SampleSeeds(*ring, options, Monitor::Null());
   options.thin_boost = 4;
   const SeedCloud boosted = SampleSeeds(*ring, options, Monitor::Null());
@@ -161,6 +166,83 @@ TEST(SampleSeeds, BadOptionsAreUsageErrors) {
   options.proj_tol_rel = 1e-5;
   options.thin_boost = 0.5;
   EXPECT_THROW(options.Check(), UsageError);
+  options.thin_boost = 2;  // both choose from a pool
+  EXPECT_THROW(options.Check(), UsageError);
+  options.spread_pool = 1;
+  EXPECT_NO_THROW(options.Check());
+  options.spread_pool = 0;
+  EXPECT_THROW(options.Check(), UsageError);
+}
+
+// Farthest-point sampling the plain way: O(n) per pick.
+std::vector<size_t> NaiveFarthest(const std::vector<Vec3>& p, size_t count) {
+  std::vector<double> d(p.size());
+  for (size_t i = 0; i < p.size(); ++i) d[i] = (p[i] - p[0]).squaredNorm();
+  std::vector<size_t> taken{0};
+  while (taken.size() < count) {
+    size_t best = 0;
+    for (size_t i = 1; i < p.size(); ++i)
+      if (d[i] > d[best]) best = i;  // ties: the lower index
+    taken.push_back(best);
+    for (size_t i = 0; i < p.size(); ++i) d[i] = std::min(d[i], (p[i] - p[best]).squaredNorm());
+  }
+  std::sort(taken.begin(), taken.end());
+  return taken;
+}
+
+TEST(Spread, FarthestPointSubsetIsTheGreedyChoiceAndCoversAtItsRadius) {
+  Rng rng(7, 0);
+  std::vector<Vec3> points(3000);
+  for (Vec3& p : points) p = Vec3(rng.Uniform(0, 1), rng.Uniform(0, 1), rng.Uniform(0, 0.2));
+  points.push_back(points[10]);  // a duplicate is never taken while distinct points are left
+  double radius = 0.0;
+  const std::vector<size_t> taken = FarthestPointSubset(points, 250, &radius);
+  EXPECT_EQ(taken, NaiveFarthest(points, 250));
+  ASSERT_EQ(taken.size(), 250u);
+  EXPECT_TRUE(std::is_sorted(taken.begin(), taken.end()));
+  EXPECT_GT(radius, 0.0);
+  double nearest_pair = INFINITY;
+  for (size_t a = 0; a < taken.size(); ++a)
+    for (size_t b = a + 1; b < taken.size(); ++b)
+      nearest_pair = std::min(nearest_pair, (points[taken[a]] - points[taken[b]]).norm());
+  EXPECT_GE(nearest_pair, radius - 1e-12);  // no two taken points are nearer than the radius ...
+  for (const Vec3& p : points) {            // ... and every point lies within it of one
+    double d = INFINITY;
+    for (size_t t : taken) d = std::min(d, (points[t] - p).norm());
+    EXPECT_LE(d, radius + 1e-12);
+  }
+  EXPECT_EQ(FarthestPointSubset(points, 5000).size(), points.size());
+}
+
+// Coefficient of variation of the nearest-neighbour distances.
+double SpacingCv(const std::vector<Vec3>& p) {
+  std::vector<double> nn(p.size(), INFINITY);
+  for (size_t i = 0; i < p.size(); ++i)
+    for (size_t j = 0; j < p.size(); ++j)
+      if (i != j) nn[i] = std::min(nn[i], (p[i] - p[j]).norm());
+  double mean = 0.0, var = 0.0;
+  for (double d : nn) mean += d / static_cast<double>(nn.size());
+  for (double d : nn) var += (d - mean) * (d - mean) / static_cast<double>(nn.size());
+  return std::sqrt(var) / mean;
+}
+
+TEST(Spread, TheSpreadPoolStartsTheSeedsEvenlySpacedOnTheSurface) {
+  const auto udf = MakeShape("torus");
+  SampleSeedsOptions options;
+  options.count = 600;
+  options.seed = 3;
+  options.spread_pool = 1;
+  const SeedCloud uniform = SampleSeeds(*udf, options, Monitor::Null());
+  options.spread_pool = 4;
+  const SeedCloud spread = SampleSeeds(*udf, options, Monitor::Null());
+  ASSERT_EQ(spread.size(), options.count);
+  const double tol = options.proj_tol_rel * udf->Domain().Diagonal();
+  for (const Vec3& p : spread.position) EXPECT_LT(udf->Distance(p), tol);
+  // Uniform points on a surface have a nearest-neighbour CV of about 0.52; a farthest-point subset of 4x
+  // as many has most pairs near its covering radius.
+  EXPECT_GT(SpacingCv(uniform.position), 0.4);
+  EXPECT_LT(SpacingCv(spread.position), 0.2);
+  EXPECT_EQ(SampleSeeds(*udf, options, Monitor::Null()).position, spread.position);
 }
 
 class SampleSeedsExe : public ::testing::Test {

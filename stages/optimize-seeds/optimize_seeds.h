@@ -35,7 +35,7 @@ struct OptimizeSeedsOptions {
   double gamma = 10.0;            ///< γ, proximity weight, lengths relative to the domain diagonal (paper: 10) (--gamma)
   double delta = 1e-3;            ///< δ, inner loop stops when the gradient changes by less than this, relatively (paper: 1e-3) (--delta)
   int max_outer_iters = 3;        ///< cap on Alg. 1's outer loop (--max-outer-iters; see docs for why 3)
-  int max_inner_iters = 10;       ///< cap on Alg. 1's inner loop (--max-inner-iters)
+  int max_inner_iters = 5;        ///< cap on Alg. 1's inner loop (--max-inner-iters); 5 with sample-seeds' spread start
   int lbfgs_max_iters = 50;       ///< L-BFGS iterations per inner round (Ceres' default) (--lbfgs-max-iters)
   double rank_threshold = 0.4;    ///< τ: rank(A) = #{singular values > τ·s_1} (--rank-threshold)
   /// A rank-1 cell whose normals show two planes turned by at least this many degrees, each seen by the share

@@ -1,4 +1,4 @@
-// sample-seeds: N seeds uniform in the UDF's domain box, projected onto its zero set (docs/sample-seeds.md).
+// sample-seeds: N seeds near the UDF's zero set, projected onto it and spread farthest apart (docs/sample-seeds.md).
 #include "common/cli.h"
 #include "common/projection.h"
 #include "stages/sample-seeds/sample_seeds.h"
@@ -9,8 +9,8 @@ int main(int argc, char** argv) {
   bool ascii = false;
 
   voroudf::StageCli cli("sample-seeds",
-                        "Draws --count points uniformly in the UDF's domain box (within a band around the surface) and "
-                        "projects each onto the zero set with x <- x - d(x) n(x); writes the converged ones as a seeds PLY.");
+                        "Draws points uniformly in the UDF's domain box (within a band around the surface), projects each onto "
+                        "the zero set with x <- x - d(x) n(x) and writes --count of them, chosen farthest apart, as a seeds PLY.");
   cli.AddUdf(&udf_spec);
   cli.AddOutput(&output, "output seeds PLY (seeds0.ply)");
   cli.AddSeed(&options.seed);
@@ -24,6 +24,8 @@ int main(int argc, char** argv) {
                  "projection tolerance on d, relative to the domain box diagonal");
   app.add_option("--proj-max-iters", options.proj_max_iters, "projection steps before a seed is dropped");
   app.add_option("--thin-boost", options.thin_boost, "up to this many times the seeds where the part is thinner than two spacings (1: uniform)");
+  app.add_option("--spread-pool", options.spread_pool,
+                 "draw this many times --count points and keep the --count farthest apart (1: uniform draws, the paper)");
   app.add_option("--proj-floor-rel", options.proj_floor_rel, voroudf::kProjFloorRelHelp);
   app.add_option("--proj-twin-factor", options.proj_twin_factor, voroudf::kProjTwinFactorHelp);
 

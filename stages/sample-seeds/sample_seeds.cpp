@@ -21,6 +21,8 @@ void SampleSeedsOptions::Check() const {
   if (!(band_rel >= 0.0)) throw UsageError("--band-rel must be >= 0");
   if (!(dedup_rel >= 0.0 && dedup_rel < 0.1)) throw UsageError("--dedup-rel must be in [0, 0.1)");
   if (!(thin_boost >= 1.0 && thin_boost <= 64.0)) throw UsageError("--thin-boost must be in [1, 64]");
+  if (spread_pool < 1 || spread_pool > 64) throw UsageError("--spread-pool must be in [1, 64]");
+  if (spread_pool > 1 && thin_boost > 1.0) throw UsageError("--thin-boost needs --spread-pool 1 (both choose the seeds from a pool of draws)");
 }
 
 namespace {
@@ -139,6 +141,22 @@ std::vector<size_t> ChooseForThinParts(const Udf& udf, const SampleSeedsOptions&
   return keep;
 }
 
+// --spread-pool: `converged` holds spread_pool x count projected draws; chooses the count farthest apart.
+std::vector<size_t> ChooseSpread(const SampleSeedsOptions& options, const std::vector<size_t>& converged,
+                                 const std::vector<Vec3>& points, Monitor& monitor) {
+  std::vector<Vec3> p(converged.size());
+  for (size_t k = 0; k < converged.size(); ++k) p[k] = points[converged[k]];
+  double radius = 0.0;
+  const std::vector<size_t> chosen = FarthestPointSubset(p, options.count, &radius);
+  std::vector<size_t> keep(chosen.size());
+  for (size_t k = 0; k < chosen.size(); ++k) keep[k] = converged[chosen[k]];
+  char line[200];
+  std::snprintf(line, sizeof line, "spread: %zu of %zu projected draws chosen farthest apart; every draw within %.3g of one",
+                chosen.size(), p.size(), radius);
+  monitor.Info(line);
+  return keep;
+}
+
 }  // namespace
 
 SeedCloud SampleSeeds(const Udf& udf, const SampleSeedsOptions& options, Monitor& monitor) {
@@ -148,6 +166,7 @@ SeedCloud SampleSeeds(const Udf& udf, const SampleSeedsOptions& options, Monitor
   SampleSeedsOptions draw_options = options;
   if (options.thin_boost > 1.0)  // a pool to choose from (ChooseForThinParts)
     draw_options.count = static_cast<size_t>(std::ceil(options.thin_boost)) * options.count;
+  if (options.spread_pool > 1) draw_options.count = static_cast<size_t>(options.spread_pool) * options.count;
   std::vector<Vec3> points = DrawInBand(udf, box, draw_options, monitor);
   ProjectionOptions proj =
       RelativeProjection(box.Diagonal(), options.proj_tol_rel, options.proj_floor_rel, options.proj_max_iters);
@@ -159,6 +178,7 @@ SeedCloud SampleSeeds(const Udf& udf, const SampleSeedsOptions& options, Monitor
     if (r.converged[i]) converged.push_back(i);
   if (options.thin_boost > 1.0 && converged.size() > 1)
     converged = ChooseForThinParts(udf, options, converged, points, r.gradient, monitor);
+  if (options.spread_pool > 1) converged = ChooseSpread(options, converged, points, monitor);
   const std::vector<size_t> kept = KeepDistinct(points, converged, options.dedup_rel * box.Diagonal());
 
   SeedCloud seeds;

@@ -34,6 +34,10 @@ struct SampleSeedsOptions {
   /// part is thinner than 2 spacings (ThinSeedWeights in thin_sizing.h), so flat parts give seeds to thin ones;
   /// 1: uniform, the paper.
   double thin_boost = 1.0;
+  /// --spread-pool K: draw K x count points and keep the count of them farthest apart (farthest-point sampling,
+  /// FarthestPointSubset in common/knn.h), so the seeds start evenly spaced and optimize-seeds' repulsion has
+  /// less to do; 1: the paper's uniform draws. Not with thin_boost > 1 (both choose from the pool).
+  int spread_pool = 4;
 
   /// Throws UsageError for values that cannot work.
   void Check() const;
@@ -44,7 +48,8 @@ struct SampleSeedsOptions {
 /// (all of them if band_rel = 0); projects each with x <- x - d(x) n(x) until d < proj_tol_rel * diagonal;
 /// keeps the converged ones in draw order, without those within dedup_rel * diagonal of an earlier seed,
 /// with their UDF value and gradient (rank 0: unknown until optimize-seeds). With thin_boost > 1 the draw is
-/// ceil(thin_boost) x count and `count` of the converged ones are chosen, likelier where the part is thin.
+/// ceil(thin_boost) x count and `count` of the converged ones are chosen, likelier where the part is thin;
+/// with spread_pool > 1 it is spread_pool x count and the `count` farthest apart are chosen.
 /// Throws NumericalError if no candidate falls in the band or none converged.
 SeedCloud SampleSeeds(const Udf& udf, const SampleSeedsOptions& options, Monitor& monitor);
 
