@@ -529,6 +529,52 @@ TEST(VoronoiCells, SamplesLieInTheirCellAndUnchangedCellsAreKept) {
   check_membership(after);
 }
 
+TEST(VoronoiCells, CellsFollowTheirSeedsWhenEarlierSeedsAreRemoved) {
+  const auto sphere = MakeShape("sphere");
+  const std::vector<Vec3> before = Initial(*sphere, 300, 8).position;
+  const SeedIndex index0(before);
+  const CellSamples first = SampleVoronoiCells(*sphere, before, index0, CellSamplingOptions(), 1, 0);
+  // Seeds 3 and 150 are dropped: every later seed's index shifts.
+  std::vector<Vec3> seeds;
+  for (size_t i = 0; i < before.size(); ++i)
+    if (i != 3 && i != 150) seeds.push_back(before[i]);
+  CellSamples carried = first;
+  std::vector<Vec3> carried_seeds = before;
+  CarryCells(seeds, CellSamplingOptions(), carried, carried_seeds);
+  ASSERT_EQ(carried_seeds.size(), seeds.size());
+  // A fresh draw for the new seeds: every carried cell must be the same set, with the same neighbours.
+  const SeedIndex index1(seeds);
+  const CellSamples fresh = SampleVoronoiCells(*sphere, seeds, index1, CellSamplingOptions(), 1, 5);
+  size_t kept = 0;
+  for (size_t i = 0; i < seeds.size(); ++i) {
+    EXPECT_EQ(carried_seeds[i], seeds[i]);  // no seed moved
+    if (carried.radius[i] == 0.0) continue;  // given up: redrawn
+    ++kept;
+    EXPECT_EQ(carried.radius[i], fresh.radius[i]) << "cell " << i;
+    std::vector<int> a(carried.neighbour.begin() + static_cast<long>(carried.neighbour_offset[i]),
+                       carried.neighbour.begin() + static_cast<long>(carried.neighbour_offset[i + 1]));
+    std::vector<int> b(fresh.neighbour.begin() + static_cast<long>(fresh.neighbour_offset[i]),
+                       fresh.neighbour.begin() + static_cast<long>(fresh.neighbour_offset[i + 1]));
+    std::sort(a.begin(), a.end());
+    std::sort(b.begin(), b.end());
+    EXPECT_EQ(a, b) << "cell " << i;
+    // Its samples are the ones seed i had before the removal.
+    const size_t old_i = i < 3 ? i : i < 149 ? i + 1 : i + 2;
+    EXPECT_TRUE(std::equal(carried.point.begin() + static_cast<long>(carried.sample_offset[i]),
+                           carried.point.begin() + static_cast<long>(carried.sample_offset[i + 1]),
+                           first.point.begin() + static_cast<long>(first.sample_offset[old_i]),
+                           first.point.begin() + static_cast<long>(first.sample_offset[old_i + 1])));
+  }
+  // Only the cells around the two removed seeds are given up, and only those are redrawn.
+  EXPECT_GT(kept, 250u);
+  const CellSamples after = SampleVoronoiCells(*sphere, seeds, index1, CellSamplingOptions(), 1, 6, &carried, &carried_seeds);
+  EXPECT_EQ(after.redrawn, seeds.size() - kept);
+  for (size_t i = 0; i < seeds.size(); ++i)
+    for (size_t m = after.sample_offset[i]; m < after.sample_offset[i + 1]; ++m)
+      for (const Vec3& other : seeds)
+        ASSERT_LE((after.point[m] - seeds[i]).norm(), (after.point[m] - other).norm() + 1e-12);
+}
+
 // Early samples: a cell that clearly sees one plane keeps the first samples of the very draw it would
 // have made whole; a cell on a cube edge or corner (two or three planes) gets all M.
 TEST(VoronoiCells, EarlySamplesArePrefixesAndFeatureCellsStayWhole) {

@@ -196,6 +196,9 @@ class Optimizer {
       }
       cell_options.early_allowed = &allowed;
     }
+    // Seeds dropped since the last call shift the later ones' indices: the cache follows them by position.
+    if (!cached_positions_.empty() && cached_positions_.size() != s.position.size())
+      CarryCells(s.position, cell_options, cached_cells_, cached_positions_);
     CellSamples cells = SampleVoronoiCells(udf_, s.position, index, cell_options, options_.seed, round_++,
                                            cached_positions_.empty() ? nullptr : &cached_cells_, &cached_positions_);
     const long n = static_cast<long>(s.position.size());

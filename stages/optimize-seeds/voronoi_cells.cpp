@@ -3,6 +3,10 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <limits>
+#include <memory>
+#include <numeric>
+#include <tuple>
 
 #include "common/rng.h"
 #include "stages/optimize-seeds/l1_tangent.h"
@@ -51,7 +55,7 @@ std::vector<char> CellsToRedraw(const std::vector<Vec3>& seeds, const SeedIndex&
 #pragma omp for schedule(dynamic, 64)
     for (long li = 0; li < static_cast<long>(n); ++li) {
       const size_t i = static_cast<size_t>(li);
-      if (moved[i]) continue;
+      if (moved[i] || !(previous->radius[i] > 0.0)) continue;  // radius 0: no cell carried (CarryCells)
       bool dirty = options.early_samples == 0 && !previous->early_kept.empty() && previous->early_kept[i];
       for (size_t k = previous->neighbour_offset[i]; k < previous->neighbour_offset[i + 1] && !dirty; ++k)
         dirty = moved[static_cast<size_t>(previous->neighbour[k])];
@@ -271,6 +275,69 @@ CellSamples SampleVoronoiCells(const Udf& udf, const std::vector<Vec3>& seeds, c
   EvaluateCells(udf, options, previous, cells, w);
   Assemble(previous, w, cells);
   return cells;
+}
+
+void CarryCells(const std::vector<Vec3>& seeds, const CellSamplingOptions& options, CellSamples& previous,
+                std::vector<Vec3>& previous_seeds) {
+  const size_t n = seeds.size(), before = previous_seeds.size();
+  // Previous seeds by exact position (ties by index), to find each seed's earlier self.
+  std::vector<size_t> order(before);
+  std::iota(order.begin(), order.end(), size_t{0});
+  const auto key = [&](size_t k) { return std::tie(previous_seeds[k].x(), previous_seeds[k].y(), previous_seeds[k].z()); };
+  std::sort(order.begin(), order.end(), [&](size_t a, size_t b) { return std::make_pair(key(a), a) < std::make_pair(key(b), b); });
+  std::vector<long> old_of(n, -1), new_of(before, -1);
+  for (size_t i = 0; i < n; ++i) {
+    const auto at = std::tie(seeds[i].x(), seeds[i].y(), seeds[i].z());
+    auto it = std::lower_bound(order.begin(), order.end(), at, [&](size_t k, const auto& v) { return key(k) < v; });
+    for (; it != order.end() && key(*it) == at; ++it) {
+      if (new_of[*it] >= 0) continue;
+      new_of[*it] = static_cast<long>(i);
+      old_of[i] = static_cast<long>(*it);
+      break;
+    }
+  }
+  std::vector<Vec3> gone;
+  for (size_t k = 0; k < before; ++k)
+    if (new_of[k] < 0) gone.push_back(previous_seeds[k]);
+  const std::unique_ptr<SeedIndex> gone_index = gone.empty() ? nullptr : std::make_unique<SeedIndex>(gone);
+  const bool marks = previous.pool_mark.size() == before, early = previous.early_kept.size() == before;
+  CellSamples carried;
+  carried.radius.assign(n, 0.0);
+  carried.neighbour_offset.assign(n + 1, 0);
+  carried.sample_offset.assign(n + 1, 0);
+  if (marks) carried.pool_mark.assign(n, 0.0);
+  if (early) carried.early_kept.assign(n, 0);
+  std::vector<Vec3> carried_seeds(n, Vec3::Constant(std::numeric_limits<double>::quiet_NaN()));
+  std::vector<int> found;
+  for (size_t i = 0; i < n; ++i) {
+    const long k = old_of[i];
+    bool keep = k >= 0;
+    const size_t ku = keep ? static_cast<size_t>(k) : 0;
+    for (size_t m = keep ? previous.neighbour_offset[ku] : 0; keep && m < previous.neighbour_offset[ku + 1]; ++m)
+      keep = new_of[static_cast<size_t>(previous.neighbour[m])] >= 0;
+    if (keep && gone_index) {
+      gone_index->WithinRadius(seeds[i], InfluenceRadius(previous.radius[ku], options), found);
+      keep = found.empty();
+    }
+    carried.neighbour_offset[i + 1] = carried.neighbour_offset[i];
+    carried.sample_offset[i + 1] = carried.sample_offset[i];
+    if (k >= 0) carried_seeds[i] = seeds[i];  // not moved, so the cells it cuts stay
+    if (!keep) continue;  // radius 0: its own cell is redrawn
+    carried.radius[i] = previous.radius[ku];
+    if (marks) carried.pool_mark[i] = previous.pool_mark[ku];
+    if (early) carried.early_kept[i] = previous.early_kept[ku];
+    for (size_t m = previous.neighbour_offset[ku]; m < previous.neighbour_offset[ku + 1]; ++m)
+      carried.neighbour.push_back(static_cast<int>(new_of[static_cast<size_t>(previous.neighbour[m])]));
+    carried.neighbour_offset[i + 1] = carried.neighbour.size();
+    for (size_t m = previous.sample_offset[ku]; m < previous.sample_offset[ku + 1]; ++m) {
+      carried.point.push_back(previous.point[m]);
+      carried.distance.push_back(previous.distance[m]);
+      carried.gradient.push_back(previous.gradient[m]);
+    }
+    carried.sample_offset[i + 1] = carried.point.size();
+  }
+  previous = std::move(carried);
+  previous_seeds = std::move(carried_seeds);
 }
 
 }  // namespace voroudf

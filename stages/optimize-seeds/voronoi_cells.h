@@ -62,10 +62,20 @@ struct CellSamples {
 /// distance of its k-th nearest seed) moved, before or after the move — such a cell is exactly the same
 /// set, so redrawing it would only change the random draw. Early on, when σ is small and few seeds
 /// move, this saves most of the UDF evaluations. Seeds appended at the end, or removed from it, since the
-/// previous call count as moved. A cell that kept only its early samples is redrawn when this call wants
+/// previous call count as moved (removals elsewhere: CarryCells first). A cell that kept only its early samples is redrawn when this call wants
 /// every cell whole (early_samples = 0).
 CellSamples SampleVoronoiCells(const Udf& udf, const std::vector<Vec3>& seeds, const SeedIndex& index,
                                const CellSamplingOptions& options, uint64_t rng_seed, uint64_t round,
                                const CellSamples* previous = nullptr, const std::vector<Vec3>* previous_seeds = nullptr);
+
+/// For SampleVoronoiCells' incremental use after seeds were removed from anywhere in the list (which shifts
+/// the indices of all later ones): re-indexes `previous` and `previous_seeds` to `seeds`. Seed i takes the
+/// cell of the previous seed at exactly its position, its neighbours re-indexed, when all of that cell's
+/// neighbours are still there and no previous seed within its influence radius has gone or moved. Any other
+/// seed gets no cell (radius 0), so its cell is redrawn; a seed with no previous seed at its position also
+/// gets a NaN previous position, so it counts as moved (the cells it cuts are redrawn too). Invariant: a
+/// carried cell is exactly the set it was. \pre previous's cells belong to previous_seeds.
+void CarryCells(const std::vector<Vec3>& seeds, const CellSamplingOptions& options, CellSamples& previous,
+                std::vector<Vec3>& previous_seeds);
 
 }  // namespace voroudf
