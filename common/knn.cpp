@@ -121,8 +121,8 @@ std::vector<size_t> FarthestPointSubset(const std::vector<Vec3>& points, size_t 
   const auto lower = [](const Entry& a, const Entry& b) {  // larger distance first, then the lower index
     return a.first < b.first || (a.first == b.first && a.second > b.second);
   };
-  std::vector<Entry> entries(n);
-  for (size_t i = 0; i < n; ++i) entries[i] = {d2[i], i};
+  std::vector<Entry> entries;  // every point but the first, which is taken
+  for (size_t i = 1; i < n; ++i) entries.emplace_back(d2[i], i);
   std::priority_queue<Entry, std::vector<Entry>, decltype(lower)> heap(lower, std::move(entries));
   const KdTree<double> tree(points, 10);
   flann::SearchParams params(flann::FLANN_CHECKS_UNLIMITED, 0.0f, false);
@@ -134,7 +134,7 @@ std::vector<size_t> FarthestPointSubset(const std::vector<Vec3>& points, size_t 
   while (taken.size() < count && !heap.empty()) {
     const auto [d, i] = heap.top();
     heap.pop();
-    if (d != d2[i] || (d == 0.0 && i == 0)) continue;  // stale, or the first point itself
+    if (d != d2[i]) continue;  // stale
     taken.push_back(i);
     last = d;
     d2[i] = 0.0;

@@ -28,6 +28,7 @@ namespace voroudf {
 namespace {
 
 using test::RunProgram;
+using test::NearestNeighbourCv;
 using test::TempDir;
 
 // ---------------------------------------------------------------------------------------------- L1 solver
@@ -609,19 +610,6 @@ TEST(VoronoiCells, EarlySamplesArePrefixesAndFeatureCellsStayWhole) {
 }
 
 // ---------------------------------------------------------------------------------------------- shapes
-
-double NearestNeighbourCv(const std::vector<Vec3>& p, double* mean_out = nullptr) {
-  std::vector<double> nn(p.size(), INFINITY);
-  for (size_t i = 0; i < p.size(); ++i)
-    for (size_t j = 0; j < p.size(); ++j)
-      if (i != j) nn[i] = std::min(nn[i], (p[i] - p[j]).norm());
-  double mean = 0, var = 0;
-  for (double d : nn) mean += d;
-  mean /= static_cast<double>(nn.size());
-  for (double d : nn) var += (d - mean) * (d - mean);
-  if (mean_out) *mean_out = mean;
-  return std::sqrt(var / static_cast<double>(nn.size())) / mean;
-}
 
 SeedCloud Initial(const Udf& udf, size_t count, uint64_t seed) {
   SampleSeedsOptions o;

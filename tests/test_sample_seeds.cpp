@@ -214,18 +214,6 @@ TEST(Spread, FarthestPointSubsetIsTheGreedyChoiceAndCoversAtItsRadius) {
   EXPECT_EQ(FarthestPointSubset(points, 5000).size(), points.size());
 }
 
-// Coefficient of variation of the nearest-neighbour distances.
-double SpacingCv(const std::vector<Vec3>& p) {
-  std::vector<double> nn(p.size(), INFINITY);
-  for (size_t i = 0; i < p.size(); ++i)
-    for (size_t j = 0; j < p.size(); ++j)
-      if (i != j) nn[i] = std::min(nn[i], (p[i] - p[j]).norm());
-  double mean = 0.0, var = 0.0;
-  for (double d : nn) mean += d / static_cast<double>(nn.size());
-  for (double d : nn) var += (d - mean) * (d - mean) / static_cast<double>(nn.size());
-  return std::sqrt(var) / mean;
-}
-
 TEST(Spread, TheSpreadPoolStartsTheSeedsEvenlySpacedOnTheSurface) {
   const auto udf = MakeShape("torus");
   SampleSeedsOptions options;
@@ -240,8 +228,8 @@ TEST(Spread, TheSpreadPoolStartsTheSeedsEvenlySpacedOnTheSurface) {
   for (const Vec3& p : spread.position) EXPECT_LT(udf->Distance(p), tol);
   // Uniform points on a surface have a nearest-neighbour CV of about 0.52; a farthest-point subset of 4x
   // as many has most pairs near its covering radius.
-  EXPECT_GT(SpacingCv(uniform.position), 0.4);
-  EXPECT_LT(SpacingCv(spread.position), 0.2);
+  EXPECT_GT(test::NearestNeighbourCv(uniform.position), 0.4);
+  EXPECT_LT(test::NearestNeighbourCv(spread.position), 0.2);
   EXPECT_EQ(SampleSeeds(*udf, options, Monitor::Null()).position, spread.position);
 }
 

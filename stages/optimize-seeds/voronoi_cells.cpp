@@ -310,18 +310,18 @@ void CarryCells(const std::vector<Vec3>& seeds, const CellSamplingOptions& optio
   std::vector<Vec3> carried_seeds(n, Vec3::Constant(std::numeric_limits<double>::quiet_NaN()));
   std::vector<int> found;
   for (size_t i = 0; i < n; ++i) {
-    const long k = old_of[i];
-    bool keep = k >= 0;
-    const size_t ku = keep ? static_cast<size_t>(k) : 0;
-    for (size_t m = keep ? previous.neighbour_offset[ku] : 0; keep && m < previous.neighbour_offset[ku + 1]; ++m)
+    carried.neighbour_offset[i + 1] = carried.neighbour_offset[i];
+    carried.sample_offset[i + 1] = carried.sample_offset[i];
+    if (old_of[i] < 0) continue;  // moved or new: NaN, no cell
+    const size_t ku = static_cast<size_t>(old_of[i]);
+    carried_seeds[i] = seeds[i];  // not moved, so the cells it cuts stay
+    bool keep = true;
+    for (size_t m = previous.neighbour_offset[ku]; keep && m < previous.neighbour_offset[ku + 1]; ++m)
       keep = new_of[static_cast<size_t>(previous.neighbour[m])] >= 0;
     if (keep && gone_index) {
       gone_index->WithinRadius(seeds[i], InfluenceRadius(previous.radius[ku], options), found);
       keep = found.empty();
     }
-    carried.neighbour_offset[i + 1] = carried.neighbour_offset[i];
-    carried.sample_offset[i + 1] = carried.sample_offset[i];
-    if (k >= 0) carried_seeds[i] = seeds[i];  // not moved, so the cells it cuts stay
     if (!keep) continue;  // radius 0: its own cell is redrawn
     carried.radius[i] = previous.radius[ku];
     if (marks) carried.pool_mark[i] = previous.pool_mark[ku];

@@ -6,6 +6,8 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <fstream>
 #include <sstream>
@@ -97,6 +99,19 @@ void WriteBytes(const std::string& path, const std::string& bytes) {
 bool Exists(const std::string& path) {
   struct stat st;
   return stat(path.c_str(), &st) == 0;
+}
+
+double NearestNeighbourCv(const std::vector<Vec3>& p, double* mean_out) {
+  std::vector<double> nn(p.size(), INFINITY);
+  for (size_t i = 0; i < p.size(); ++i)
+    for (size_t j = 0; j < p.size(); ++j)
+      if (i != j) nn[i] = std::min(nn[i], (p[i] - p[j]).norm());
+  double mean = 0, var = 0;
+  for (double d : nn) mean += d;
+  mean /= static_cast<double>(nn.size());
+  for (double d : nn) var += (d - mean) * (d - mean);
+  if (mean_out) *mean_out = mean;
+  return std::sqrt(var / static_cast<double>(nn.size())) / mean;
 }
 
 }  // namespace voroudf::test

@@ -3,6 +3,8 @@
 #include <string>
 #include <vector>
 
+#include "common/types.h"
+
 namespace voroudf::test {
 
 /// A fresh directory under $TMPDIR, removed with its contents when the object goes.
@@ -33,5 +35,9 @@ RunResult RunProgram(const std::string& program, const std::vector<std::string>&
 std::string ReadBytes(const std::string& path);
 void WriteBytes(const std::string& path, const std::string& bytes);
 bool Exists(const std::string& path);
+
+/// Coefficient of variation of the points' nearest-neighbour distances (the spacing's evenness; about 0.52
+/// for uniform random points on a surface); `*mean_out`, if given, receives their mean. O(n²).
+double NearestNeighbourCv(const std::vector<Vec3>& p, double* mean_out = nullptr);
 
 }  // namespace voroudf::test
