@@ -354,7 +354,8 @@ TEST(BuildGvd, OverPrunedGraphsLeaveUnreachedSamplesCounted) {
   EXPECT_GT(r.stats.edges_pruned_udf, 0u);
 }
 
-// build-gvd queries a midpoint only when the Lipschitz bound min(d(a), d(b)) + |ab|/2 exceeds eps_udf; the
+// build-gvd queries a midpoint only when neither the Lipschitz bound from the edge's ends, min(d(a), d(b)) +
+// |ab|/2, nor the one from the node nearest the midpoint, d(c) + |mid - c|, keeps the rise under eps_udf; the
 // kept graph must still be exactly the edges whose midpoint is within eps_udf (checked here by querying all).
 TEST(BuildGvd, KeptEdgesHaveTheirMidpointWithinEpsUdf) {
   const auto udf = MakeShape("sphere");
@@ -372,6 +373,9 @@ TEST(BuildGvd, KeptEdgesHaveTheirMidpointWithinEpsUdf) {
     long_kept += 0.5 * (b - a).norm() > eps;  // edges the bound alone could not accept
   }
   EXPECT_GT(long_kept, 0u);
+  // Where a node lies within eps_udf of the midpoint it settles the test: fewer midpoints asked than uncertain.
+  EXPECT_GT(r.stats.midpoints_uncertain, 0u);
+  EXPECT_LT(r.stats.midpoints_queried, r.stats.midpoints_uncertain);
 }
 
 // A closed plate [-0.4, 0.4]^2 x [-t/2, t/2] as a mesh UDF (12 triangles).

@@ -76,6 +76,7 @@ void RegionNormals(const std::vector<Vec3>& node, const std::vector<int>& label,
 void BuildGvdOptions::Check() const {
   if (!(samples_per_seed >= 1.0 && samples_per_seed <= 1e5)) throw UsageError("--samples-per-seed must be in [1, 1e5]");
   if (!(space_fraction >= 0.0 && space_fraction <= 1.0)) throw UsageError("--space-fraction must be in [0, 1]");
+  if (!(interior_share > 0.0 && interior_share <= 1.0)) throw UsageError("--interior-share must be in (0, 1]");
   if (!(ball_scale > 0.0 && ball_scale <= 100.0)) throw UsageError("--ball-scale must be in (0, 100]");
   if (knn < 3 || knn > 200) throw UsageError("--knn must be in [3, 200]");
   if (!(eps_udf_rel > 0.0 && eps_udf_rel < 1.0)) throw UsageError("--eps-udf-rel must be in (0, 1)");
@@ -168,6 +169,58 @@ std::vector<Vec3> DrawSamples(const SeedCloud& seeds, const Box& box, const Buil
   *in_space_out = in_space;
   *tangent_out = std::move(tangent);
   return samples;
+}
+
+// A sample within this share of the seeds' distance from a bisector counts as near a region's border
+// (--interior-share): on a hexagonal arrangement half of a region's area.
+constexpr double kBorderMargin = 0.15;
+
+// Step 1a (--interior-share): keeps the samples near the borders of the seeds' Euclidean Voronoi regions and
+// interior_share of the others, drawn from the sample's own stream. Before projection: on a sheet a bisector
+// of two seeds stands across the sheet, so a point keeps its side of it while projection moves it along the
+// normal. The ball samples of curve seeds are all kept (step 1b draws them again, and their regions hold the
+// feature chains). Compacts `samples`, `*in_space` and `tangent` in place; returns how many were dropped.
+size_t KeepNearBorders(const SeedCloud& seeds, const BuildGvdOptions& options, std::vector<Vec3>& samples,
+                       size_t* in_space, TangentDraws& tangent) {
+  if (options.interior_share >= 1.0 || seeds.size() < 2) return 0;
+  const int k = 4;
+  const std::vector<int> nearest = NearestIndices(seeds.position, samples, Monitor::Null(), k);
+  const size_t kk = nearest.size() / samples.size();
+  const uint64_t stream_seed = SplitMix64(options.seed ^ 0x6B6565704E656172ull);
+  std::vector<char> keep(samples.size(), 1);
+#pragma omp parallel for schedule(static)
+  for (long li = 0; li < static_cast<long>(samples.size()); ++li) {
+    const size_t i = static_cast<size_t>(li);
+    if (i >= *in_space && IsCurveSeed(seeds, static_cast<size_t>(tangent.owner[i - *in_space]))) continue;
+    const Vec3& s1 = seeds.position[static_cast<size_t>(nearest[i * kk])];
+    double margin = INFINITY;
+    for (size_t j = 1; j < kk; ++j) {
+      const Vec3 across = seeds.position[static_cast<size_t>(nearest[i * kk + j])] - s1;
+      const double sq = across.squaredNorm();
+      if (sq > 0.0) margin = std::min(margin, (s1 + 0.5 * across - samples[i]).dot(across) / sq);
+    }
+    if (margin < kBorderMargin) continue;
+    Rng rng(stream_seed, i);
+    keep[i] = rng.Uniform() < options.interior_share;
+  }
+  size_t out = 0, box_kept = 0;
+  for (size_t i = 0; i < samples.size(); ++i) {
+    if (!keep[i]) continue;
+    samples[out] = samples[i];
+    if (i < *in_space) {
+      ++box_kept;
+    } else {
+      tangent.owner[out - box_kept] = tangent.owner[i - *in_space];
+      if (!tangent.disc.empty()) tangent.disc[out - box_kept] = tangent.disc[i - *in_space];
+    }
+    ++out;
+  }
+  const size_t dropped = samples.size() - out;
+  samples.resize(out);
+  tangent.owner.resize(out - box_kept);
+  if (!tangent.disc.empty()) tangent.disc.resize(out - box_kept);
+  *in_space = box_kept;
+  return dropped;
 }
 
 // Step 1b (--curve-samples tangent): the ball samples of the seeds on curves and corners (rank 2 and 3 in
@@ -352,24 +405,44 @@ std::vector<char> KeptEdges(const Udf& udf, const std::vector<Vec3>& node, const
   for (size_t e = 0; e < edges.size(); ++e)
     if (may_fail[e]) queried.push_back(e);
   std::vector<char>().swap(may_fail);
+  auto rise_bound_ok = [&](size_t e, double d_mid_bound) {
+    const double ends = std::max(node_d[static_cast<size_t>(edges[e].first)], node_d[static_cast<size_t>(edges[e].second)]);
+    return d_mid_bound - ends <= eps_udf;
+  };
+  std::vector<Vec3> mid(queried.size());
+#pragma omp parallel for schedule(static)
+  for (long q = 0; q < static_cast<long>(queried.size()); ++q) {
+    const auto& ed = edges[queried[static_cast<size_t>(q)]];
+    mid[static_cast<size_t>(q)] = 0.5 * (node[static_cast<size_t>(ed.first)] + node[static_cast<size_t>(ed.second)]);
+  }
+  // Any node c bounds d(mid) ≤ d(c) + |mid - c| by the same Lipschitz argument; the node nearest the midpoint
+  // usually lies within a sample spacing of it and settles the test without a query (a kd-tree search is far
+  // cheaper than a learned UDF's evaluation).
+  const size_t could_fail = queried.size();
+  if (!queried.empty()) {
+    const std::vector<int> nearest = NearestIndices(node, mid, Monitor::Null());
+    size_t out = 0;
+    for (size_t q = 0; q < queried.size(); ++q) {
+      const size_t c = static_cast<size_t>(nearest[q]);
+      if (rise_bound_ok(queried[q], node_d[c] + (mid[q] - node[c]).norm())) continue;
+      queried[out] = queried[q];
+      mid[out++] = mid[q];
+    }
+    queried.resize(out);
+    mid.resize(out);
+  }
   std::vector<double> mid_d;
   {
-    std::vector<Vec3> mid(queried.size());
     std::vector<Vec3> mid_n;
-#pragma omp parallel for schedule(static)
-    for (long q = 0; q < static_cast<long>(queried.size()); ++q) {
-      const auto& ed = edges[queried[static_cast<size_t>(q)]];
-      mid[static_cast<size_t>(q)] = 0.5 * (node[static_cast<size_t>(ed.first)] + node[static_cast<size_t>(ed.second)]);
-    }
     udf.Evaluate(mid, mid_d, mid_n);
   }
+  std::vector<Vec3>().swap(mid);
   std::vector<char> too_far(edges.size(), 0);
-  for (size_t q = 0; q < queried.size(); ++q) {
-    const auto& ed = edges[queried[q]];
-    const double ends = std::max(node_d[static_cast<size_t>(ed.first)], node_d[static_cast<size_t>(ed.second)]);
-    too_far[queried[q]] = !(mid_d[q] - ends <= eps_udf);
-  }
-  monitor.Debug(Format("midpoints evaluated: %zu of %zu edges could fail the test", queried.size(), edges.size()));
+  for (size_t q = 0; q < queried.size(); ++q) too_far[queried[q]] = !rise_bound_ok(queried[q], mid_d[q]);
+  stats.midpoints_uncertain = could_fail;
+  stats.midpoints_queried = queried.size();
+  monitor.Debug(Format("midpoints: %zu of %zu edges could fail the test by their ends, %zu by the nearest node; those "
+                       "evaluated", could_fail, edges.size(), queried.size()));
   std::vector<char> keep(edges.size(), 0);
   size_t pruned_udf = 0, pruned_grad = 0;
 #pragma omp parallel for schedule(static) reduction(+ : pruned_udf, pruned_grad)
@@ -508,8 +581,9 @@ Nodes DenseNodes(const Udf& udf, const SeedCloud& seeds, const BuildGvdOptions& 
   size_t in_space = 0;
   TangentDraws tangent;
   std::vector<Vec3> samples = DrawSamples(seeds, box, options, &in_space, &tangent);
+  stats.samples_drawn = samples.size();
+  stats.samples_interior_dropped = KeepNearBorders(seeds, options, samples, &in_space, tangent);
   const size_t total = samples.size();
-  stats.samples_drawn = total;
   ProjectionOptions proj = RelativeProjection(diag, options.proj_tol_rel, options.proj_floor_rel, options.proj_max_iters);
   proj.twin_factor = options.proj_twin_factor;
   ProjectionResult projected = ProjectToZeroSet(udf, samples, proj, monitor);
@@ -533,10 +607,10 @@ Nodes DenseNodes(const Udf& udf, const SeedCloud& seeds, const BuildGvdOptions& 
   if (stats.seeds_duplicate > 0)
     monitor.Warn(Format("%zu seeds coincide with an earlier seed (same 2^-21 Morton cell) and are left out",
                         stats.seeds_duplicate));
-  monitor.Info(Format("%zu dense samples drawn (%zu in the box, %zu around seeds), %zu on the zero set, "
-                      "%zu duplicates dropped; graph of %zu nodes (%zu seeds)",
-                      total, in_space, total - in_space, stats.samples_projected, stats.samples_duplicate, n,
-                      num_seeds - stats.seeds_duplicate));
+  monitor.Info(Format("%zu dense samples drawn, %zu kept (%zu in the box, %zu around seeds; the rest deep inside a "
+                      "region), %zu on the zero set, %zu duplicates dropped; graph of %zu nodes (%zu seeds)",
+                      stats.samples_drawn, total, in_space, total - in_space, stats.samples_projected,
+                      stats.samples_duplicate, n, num_seeds - stats.seeds_duplicate));
   // UDF values and gradients at the nodes (on the zero set a surface normal of either orientation): a
   // sample's are the projection's last evaluation, at that very point (MakeNodes); only the seeds are asked
   // (a third of the stage's queries were the samples' again).

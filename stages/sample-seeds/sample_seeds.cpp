@@ -51,11 +51,15 @@ std::vector<Vec3> DrawInBand(const Udf& udf, const Box& box, const SampleSeedsOp
   std::vector<double> d;
   std::vector<Vec3> g;
   Task task(monitor, "drawing in the band", options.count);
+  // The points kept are the first `count` in candidate order whatever the batches, so the batch sizes set
+  // only how many candidates beyond the last kept one are asked: a first batch of kPilot measures the band's
+  // share of the box, and each later one asks for what is still wanted at that rate, plus a fifth.
+  constexpr double kPilot = 65536.0, kMinBatch = 4096.0;
   while (points.size() < options.count && next < max_candidates) {
-    // Grow the batch with the observed acceptance rate (at least 64k candidates).
-    const double rate = next ? std::max(1e-4, static_cast<double>(points.size()) / static_cast<double>(next)) : 0.05;
+    const double rate = std::max(1e-4, static_cast<double>(points.size()) / static_cast<double>(next));
     const size_t want = options.count - points.size();
-    const size_t n = static_cast<size_t>(std::clamp(1.2 * static_cast<double>(want) / rate, 65536.0, 1e7));
+    const size_t n = next == 0 ? static_cast<size_t>(kPilot)
+                               : static_cast<size_t>(std::clamp(1.2 * static_cast<double>(want) / rate, kMinBatch, 1e7));
     batch.resize(n);
     for (size_t k = 0; k < n; ++k) batch[k] = Candidate(box, options.seed, next + k);
     udf.Evaluate(batch, d, g);
