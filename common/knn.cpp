@@ -76,30 +76,27 @@ std::vector<int> KNearestAmong(const std::vector<Vec3>& points, int k, int* k_ou
   return result;
 }
 
-std::vector<int> NearestIndices(const std::vector<Vec3>& data, const std::vector<Vec3>& queries, Monitor& monitor,
-                                int k) {
+std::vector<int> NearestIndices(const std::vector<Vec3>& data, const std::vector<Vec3>& queries, Monitor& monitor) {
   if (data.empty()) throw Error("NearestIndices: no data point");
-  const size_t kk = std::min(static_cast<size_t>(std::max(k, 1)), data.size());
-  std::vector<int> nearest(queries.size() * kk, -1);
+  std::vector<int> nearest(queries.size(), -1);
   if (queries.empty()) return nearest;
   const KdTree<double> tree(data, 10);
   flann::SearchParams params = ExactSearch();
-  params.sorted = kk > 1;
+  params.sorted = false;
   const std::vector<size_t> order = MortonOrder(queries, BoundingBox(queries));
   const size_t block = 16384;
   std::vector<double> q(3 * block);
-  std::vector<int> index(block * kk);
-  std::vector<double> dist2(block * kk);
+  std::vector<int> index(block);
+  std::vector<double> dist2(block);
   for (size_t begin = 0; begin < queries.size(); begin += block) {
     const size_t end = std::min(queries.size(), begin + block);
     for (size_t i = begin; i < end; ++i)
-      for (int c = 0; c < 3; ++c) q[3 * (i - begin) + static_cast<size_t>(c)] = queries[order[i]][c];
+      for (int k = 0; k < 3; ++k) q[3 * (i - begin) + static_cast<size_t>(k)] = queries[order[i]][k];
     flann::Matrix<double> qm(q.data(), end - begin, 3);
-    flann::Matrix<int> im(index.data(), end - begin, kk);
-    flann::Matrix<double> dm(dist2.data(), end - begin, kk);
-    tree.index->knnSearch(qm, im, dm, kk, params);
-    for (size_t i = begin; i < end; ++i)
-      std::copy_n(index.begin() + static_cast<long>((i - begin) * kk), kk, nearest.begin() + static_cast<long>(order[i] * kk));
+    flann::Matrix<int> im(index.data(), end - begin, 1);
+    flann::Matrix<double> dm(dist2.data(), end - begin, 1);
+    tree.index->knnSearch(qm, im, dm, 1, params);
+    for (size_t i = begin; i < end; ++i) nearest[order[i]] = index[i - begin];
     monitor.Advance(end - begin);
   }
   return nearest;

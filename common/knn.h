@@ -16,11 +16,10 @@ namespace voroudf {
 std::vector<int> KNearestAmong(const std::vector<Vec3>& points, int k, int* k_out, Monitor& monitor,
                                const std::string& task_name);
 
-/// For each query, the indices of its k' = min(k, data.size()) nearest points of `data` in increasing distance,
-/// a row-major queries x k' table (exact; ties to the one FLANN meets first, which is fixed for fixed inputs).
-/// Queries run in Morton order for cache locality, which changes no result. \pre `data` is not empty, k >= 1
-std::vector<int> NearestIndices(const std::vector<Vec3>& data, const std::vector<Vec3>& queries, Monitor& monitor,
-                                int k = 1);
+/// For each query, the index of its nearest point of `data` (exact; ties to the one FLANN meets first,
+/// which is fixed for fixed inputs). Queries run in Morton order for cache locality, which changes no
+/// result. \pre `data` is not empty
+std::vector<int> NearestIndices(const std::vector<Vec3>& data, const std::vector<Vec3>& queries, Monitor& monitor);
 
 /// Farthest-point sampling (Eldar, Lindenbaum, Porat & Zeevi 1997, "The farthest point strategy for
 /// progressive image sampling"): starting from points[0], repeatedly takes the point farthest from all taken

@@ -76,7 +76,6 @@ void RegionNormals(const std::vector<Vec3>& node, const std::vector<int>& label,
 void BuildGvdOptions::Check() const {
   if (!(samples_per_seed >= 1.0 && samples_per_seed <= 1e5)) throw UsageError("--samples-per-seed must be in [1, 1e5]");
   if (!(space_fraction >= 0.0 && space_fraction <= 1.0)) throw UsageError("--space-fraction must be in [0, 1]");
-  if (!(interior_share > 0.0 && interior_share <= 1.0)) throw UsageError("--interior-share must be in (0, 1]");
   if (!(ball_scale > 0.0 && ball_scale <= 100.0)) throw UsageError("--ball-scale must be in (0, 100]");
   if (knn < 3 || knn > 200) throw UsageError("--knn must be in [3, 200]");
   if (!(eps_udf_rel > 0.0 && eps_udf_rel < 1.0)) throw UsageError("--eps-udf-rel must be in (0, 1)");
@@ -169,58 +168,6 @@ std::vector<Vec3> DrawSamples(const SeedCloud& seeds, const Box& box, const Buil
   *in_space_out = in_space;
   *tangent_out = std::move(tangent);
   return samples;
-}
-
-// A sample within this share of the seeds' distance from a bisector counts as near a region's border
-// (--interior-share): on a hexagonal arrangement half of a region's area.
-constexpr double kBorderMargin = 0.15;
-
-// Step 1a (--interior-share): keeps the samples near the borders of the seeds' Euclidean Voronoi regions and
-// interior_share of the others, drawn from the sample's own stream. Before projection: on a sheet a bisector
-// of two seeds stands across the sheet, so a point keeps its side of it while projection moves it along the
-// normal. The ball samples of curve seeds are all kept (step 1b draws them again, and their regions hold the
-// feature chains). Compacts `samples`, `*in_space` and `tangent` in place; returns how many were dropped.
-size_t KeepNearBorders(const SeedCloud& seeds, const BuildGvdOptions& options, std::vector<Vec3>& samples,
-                       size_t* in_space, TangentDraws& tangent) {
-  if (options.interior_share >= 1.0 || seeds.size() < 2) return 0;
-  const int k = 4;
-  const std::vector<int> nearest = NearestIndices(seeds.position, samples, Monitor::Null(), k);
-  const size_t kk = nearest.size() / samples.size();
-  const uint64_t stream_seed = SplitMix64(options.seed ^ 0x6B6565704E656172ull);
-  std::vector<char> keep(samples.size(), 1);
-#pragma omp parallel for schedule(static)
-  for (long li = 0; li < static_cast<long>(samples.size()); ++li) {
-    const size_t i = static_cast<size_t>(li);
-    if (i >= *in_space && IsCurveSeed(seeds, static_cast<size_t>(tangent.owner[i - *in_space]))) continue;
-    const Vec3& s1 = seeds.position[static_cast<size_t>(nearest[i * kk])];
-    double margin = INFINITY;
-    for (size_t j = 1; j < kk; ++j) {
-      const Vec3 across = seeds.position[static_cast<size_t>(nearest[i * kk + j])] - s1;
-      const double sq = across.squaredNorm();
-      if (sq > 0.0) margin = std::min(margin, (s1 + 0.5 * across - samples[i]).dot(across) / sq);
-    }
-    if (margin < kBorderMargin) continue;
-    Rng rng(stream_seed, i);
-    keep[i] = rng.Uniform() < options.interior_share;
-  }
-  size_t out = 0, box_kept = 0;
-  for (size_t i = 0; i < samples.size(); ++i) {
-    if (!keep[i]) continue;
-    samples[out] = samples[i];
-    if (i < *in_space) {
-      ++box_kept;
-    } else {
-      tangent.owner[out - box_kept] = tangent.owner[i - *in_space];
-      if (!tangent.disc.empty()) tangent.disc[out - box_kept] = tangent.disc[i - *in_space];
-    }
-    ++out;
-  }
-  const size_t dropped = samples.size() - out;
-  samples.resize(out);
-  tangent.owner.resize(out - box_kept);
-  if (!tangent.disc.empty()) tangent.disc.resize(out - box_kept);
-  *in_space = box_kept;
-  return dropped;
 }
 
 // Step 1b (--curve-samples tangent): the ball samples of the seeds on curves and corners (rank 2 and 3 in
@@ -581,9 +528,8 @@ Nodes DenseNodes(const Udf& udf, const SeedCloud& seeds, const BuildGvdOptions& 
   size_t in_space = 0;
   TangentDraws tangent;
   std::vector<Vec3> samples = DrawSamples(seeds, box, options, &in_space, &tangent);
-  stats.samples_drawn = samples.size();
-  stats.samples_interior_dropped = KeepNearBorders(seeds, options, samples, &in_space, tangent);
   const size_t total = samples.size();
+  stats.samples_drawn = total;
   ProjectionOptions proj = RelativeProjection(diag, options.proj_tol_rel, options.proj_floor_rel, options.proj_max_iters);
   proj.twin_factor = options.proj_twin_factor;
   ProjectionResult projected = ProjectToZeroSet(udf, samples, proj, monitor);
@@ -607,10 +553,10 @@ Nodes DenseNodes(const Udf& udf, const SeedCloud& seeds, const BuildGvdOptions& 
   if (stats.seeds_duplicate > 0)
     monitor.Warn(Format("%zu seeds coincide with an earlier seed (same 2^-21 Morton cell) and are left out",
                         stats.seeds_duplicate));
-  monitor.Info(Format("%zu dense samples drawn, %zu kept (%zu in the box, %zu around seeds; the rest deep inside a "
-                      "region), %zu on the zero set, %zu duplicates dropped; graph of %zu nodes (%zu seeds)",
-                      stats.samples_drawn, total, in_space, total - in_space, stats.samples_projected,
-                      stats.samples_duplicate, n, num_seeds - stats.seeds_duplicate));
+  monitor.Info(Format("%zu dense samples drawn (%zu in the box, %zu around seeds), %zu on the zero set, "
+                      "%zu duplicates dropped; graph of %zu nodes (%zu seeds)",
+                      total, in_space, total - in_space, stats.samples_projected, stats.samples_duplicate, n,
+                      num_seeds - stats.seeds_duplicate));
   // UDF values and gradients at the nodes (on the zero set a surface normal of either orientation): a
   // sample's are the projection's last evaluation, at that very point (MakeNodes); only the seeds are asked
   // (a third of the stage's queries were the samples' again).

@@ -27,11 +27,6 @@ struct BuildGvdOptions {
   /// boundaries (whole wedges of space project onto them), which is where the graph must connect sheets;
   /// ball samples follow the seed density.
   double space_fraction = 0.25;
-  /// Share of the dense samples kept where they lie deep inside one seed's region (--interior-share): a
-  /// sample farther from every bisector of its nearest seed and the next three than kBorderMargin x those
-  /// seeds' distance is kept with this chance. The diagram's borders and vertices are where the sweep must
-  /// resolve; inside a region the graph only carries distances. 1: every sample.
-  double interior_share = 1.0;
   /// --curve-samples: "tangent", the ball samples of curve and corner seeds (rank 2, 3) are drawn again in
   /// the tangent plane where they landed, for an even density on each sheet up to where sheets cross;
   /// "ball", every ball sample as it lands.
@@ -84,7 +79,6 @@ struct BuildGvdOptions {
 /// What BuildGvd did, for logs and tests.
 struct BuildGvdStats {
   size_t samples_drawn = 0;
-  size_t samples_interior_dropped = 0;  ///< left out deep inside a seed's region (--interior-share)
   size_t samples_projected = 0;   ///< converged onto the zero set
   size_t samples_redrawn = 0;     ///< ball samples of curve seeds replaced by their tangent-plane redraw (step 1b)
   size_t samples_duplicate = 0;   ///< dropped because another node sits at (numerically) the same place

@@ -23,8 +23,6 @@ int main(int argc, char** argv) {
   app.add_flag("--graph", graph, "with --labels: also write the pruned kNN graph as an edge element");
   app.add_option("--samples-per-seed", options.samples_per_seed, "dense samples drawn per seed");
   app.add_option("--space-fraction", options.space_fraction, "fraction of dense samples drawn in the whole box");
-  app.add_option("--interior-share", options.interior_share,
-                 "share of dense samples kept deep inside a seed's region, away from its borders (1: all)");
   app.add_option("--curve-samples", options.curve_samples,
                  "tangent: curve and corner seeds' ball samples drawn again in the tangent plane where they landed "
                  "(even density up to where sheets cross); ball: as they land")
