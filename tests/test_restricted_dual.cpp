@@ -174,6 +174,38 @@ TEST(ChainLinks, WhereSheetsCrossAtAGapOfTheChainEachSheetKeepsItsTriangleOnTheL
   }
 }
 
+// A tent over a link: sheet seed 2's region reached past the chain between 0 and 1, so the samples saw it
+// meet seed 4 of another half-plane there: (0, 2, 4) and (1, 2, 4) instead of 4's triangle on the link.
+TEST(ChainLinks, ATentOverALinkIsFlippedOntoTheLink) {
+  const std::vector<uint8_t> is_curve = {1, 1, 0, 0, 0, 0, 1, 1};
+  for (uint64_t seed = 1; seed <= 10; ++seed) {
+    const std::vector<Vec3> p = CrossingCluster(0.05, seed);
+    std::vector<Tri> tent = {{0, 1, 2}, {0, 1, 3}, {0, 1, 5}, {0, 2, 4}, {1, 2, 4}};
+    for (int s = 2; s < 6; ++s) {
+      tent.push_back({0, s, 6});
+      tent.push_back({1, s, 7});
+    }
+    std::sort(tent.begin(), tent.end());
+    ChainLinkStats stats;
+    const std::vector<Tri> kept = KeepChainLinks(p, is_curve, tent, &stats);
+    EXPECT_EQ(stats.tents, 1u);
+    const std::set<Tri> k(kept.begin(), kept.end());
+    for (int s = 2; s < 6; ++s) EXPECT_TRUE(k.count({0, 1, s})) << "the link's triangle on half-plane " << s;
+    EXPECT_FALSE(k.count({0, 2, 4}) || k.count({1, 2, 4}));
+    EXPECT_EQ(kept.size(), tent.size() - 1);
+    const auto after = TriplesPerEdge(kept);
+    for (const auto& [e, n] : TriplesPerEdge(tent)) {
+      const auto it = after.find(e);
+      EXPECT_TRUE(n == 1 || it == after.end() || it->second != 1) << e[0] << "-" << e[1] << ": opened";
+    }
+    // With seed 4 moved to seed 2's side of the link (within 60 degrees), it is one sheet's fan: left alone.
+    std::vector<Vec3> same_side = p;
+    same_side[4] = {0.45, 0.5, 0.2};
+    EXPECT_EQ(KeepChainLinks(same_side, is_curve, tent, &stats), tent);
+    EXPECT_EQ(stats.tents, 0u);
+  }
+}
+
 TEST(ChainLinks, SeedsOnOneSideOfTheLinkOrNoChainAreLeftToTheCharts) {
   // A closed tetrahedron of two seeds on a crease and two on the same face: the triangulation of that face
   // is the chart's decision (LocallyDelaunayTriples), not the link's.

@@ -254,6 +254,34 @@ void KeepLinksAcrossCrossings(const std::vector<Vec3>& seeds, const Chain& chain
   }
 }
 
+// A tent over a link cc': the triple (c, c', a) of one side's fan is there, the other side's sheet seed b is
+// joined to it across the link by (c, a, b) and (c', a, b), and (c, c', b) is missing (a's region reached
+// past the chain between c and c', so the samples saw a and b meet there). The two triples on ab become
+// (c, c', b) (KeepChainLinks).
+size_t FlipTentsOntoLinks(const std::vector<Vec3>& seeds, const Chain& chain, const std::vector<uint8_t>& is_curve,
+                          const std::vector<std::vector<int>>& neighbours, LiveTriples& live) {
+  const double max_same_side_cos = std::cos(kLinkSideAngleDeg * M_PI / 180.0);
+  size_t flipped = 0;
+  for (const auto& [c, d] : chain.links) {
+    const Vec3 axis = (seeds[static_cast<size_t>(d)] - seeds[static_cast<size_t>(c)]).normalized();
+    auto across = [&](int x) {
+      return AcrossLine(seeds[static_cast<size_t>(c)], axis, seeds[static_cast<size_t>(x)]);
+    };
+    for (int a : live.Thirds(c, d, neighbours)) {
+      if (is_curve[static_cast<size_t>(a)]) continue;
+      for (int b : live.Thirds(c, a, neighbours)) {
+        if (is_curve[static_cast<size_t>(b)] || b == d || live.Has(c, d, b) || !live.Has(d, a, b)) continue;
+        if (live.OnEdge(a, b) != 2 || !(across(a).dot(across(b)) < max_same_side_cos)) continue;
+        if (live.ReplaceUnlessItOpens({SortedTri({c, a, b}), SortedTri({d, a, b})}, {SortedTri({c, d, b})})) {
+          ++flipped;
+          break;  // a's triples changed: its next link
+        }
+      }
+    }
+  }
+  return flipped;
+}
+
 }  // namespace
 
 std::vector<Tri> KeepChainLinks(const std::vector<Vec3>& seeds, const std::vector<uint8_t>& is_curve,
@@ -265,6 +293,7 @@ std::vector<Tri> KeepChainLinks(const std::vector<Vec3>& seeds, const std::vecto
   LiveTriples live(triples);
   stats.jumps = DropChainJumps(seeds, is_curve, chain, neighbours, live);
   KeepLinksAcrossCrossings(seeds, chain, is_curve, neighbours, live);
+  stats.tents = FlipTentsOntoLinks(seeds, chain, is_curve, neighbours, live);
   std::vector<Tri> kept;
   kept.reserve(triples.size());
   for (const Tri& t : triples)

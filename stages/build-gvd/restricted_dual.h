@@ -58,14 +58,15 @@ struct ChainLinkStats {
   size_t links = 0;    ///< chain links found between curve seeds
   size_t jumps = 0;    ///< jumps over a curve seed whose triples were dropped
   size_t dropped = 0;  ///< triples dropped in all
-  size_t added = 0;    ///< triples the splits of jumps added (not witnessed)
+  size_t added = 0;    ///< triples the splits of jumps and the tent flips added (not witnessed)
+  size_t tents = 0;    ///< tents over a link flipped onto it
 };
 
 /// The triples that follow the feature chains instead of jumping along or across them. A *chain link* is a
 /// pair of curve seeds (c, c') (rank 2 or 3: on a crease, a rim, a branching curve or a corner) that are
 /// geodesic neighbours (they share a triple) and consecutive: no third curve seed that is a geodesic
 /// neighbour of both lies strictly inside the sphere with diameter cc' (the Gabriel rule among the curve
-/// seeds; Gabriel & Sokal 1969). Two rules, in this order:
+/// seeds; Gabriel & Sokal 1969). Three rules, in this order:
 ///  - **jumps**: where x and y are both linked to a curve seed c, more than 135 degrees apart at c, and are no
 ///    link themselves, the triples on xy jump c along the chain. Each (x, y, z) is split at c into (x, c, z)
 ///    and (c, y, z) (z = c: the sliver along the chain, replaced by nothing). Where z is a sheet seed, the
@@ -79,9 +80,12 @@ struct ChainLinkStats {
 ///    the chain, the triples on ab cut across the curve; no chart decides there (the four seeds span two
 ///    planes), and thin-mesh's pair rule needs an edge of exactly two triples (an edge of two, across a
 ///    crease, is left to it).
+///  - **tents**: where (c, c', a), (c, a, b) and (c', a, b) are present and (c, c', b) is not, a and b are sheet
+///    seeds on two sides of the link and ab carries just those two triples, the two on ab become (c, c', b):
+///    a's region reached past the chain between c and c', and b's triangle on the link went unseen.
 ///
 /// Invariant: a triple is dropped only where the triples that replace it are present or added (a jump's
-/// halves cover its triangle but for the sliver along the chain), and a change that would leave any edge
+/// halves cover its triangle but for the sliver along the chain, a tent's the link's triangle on b's side), and a change that would leave any edge
 /// with one triple where it had more is not made: no new boundary edge appears, so no hole opens. Jumps and
 /// links are taken in seed order on the live triples (deterministic).
 ///
