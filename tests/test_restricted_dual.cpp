@@ -143,6 +143,16 @@ std::vector<Tri> CrossingTriples() {
   return t;
 }
 
+// `triples` with the triangles of the given half-planes on the chain beyond the gap (0-6 and 1-7), sorted.
+std::vector<Tri> WithChainBeyond(std::vector<Tri> triples, const std::vector<int>& half_planes) {
+  for (int s : half_planes) {
+    triples.push_back({0, s, 6});
+    triples.push_back({1, s, 7});
+  }
+  std::sort(triples.begin(), triples.end());
+  return triples;
+}
+
 std::map<Edge, int> TriplesPerEdge(const std::vector<Tri>& triples) {
   std::map<Edge, int> count;
   for (const Tri& t : triples)
@@ -180,15 +190,10 @@ TEST(ChainLinks, ATentOverALinkIsFlippedOntoTheLink) {
   const std::vector<uint8_t> is_curve = {1, 1, 0, 0, 0, 0, 1, 1};
   for (uint64_t seed = 1; seed <= 10; ++seed) {
     const std::vector<Vec3> p = CrossingCluster(0.05, seed);
-    std::vector<Tri> tent = {{0, 1, 2}, {0, 1, 3}, {0, 1, 5}, {0, 2, 4}, {1, 2, 4}};
-    for (int s = 2; s < 6; ++s) {
-      tent.push_back({0, s, 6});
-      tent.push_back({1, s, 7});
-    }
-    std::sort(tent.begin(), tent.end());
+    const std::vector<Tri> tent = WithChainBeyond({{0, 1, 2}, {0, 1, 3}, {0, 1, 5}, {0, 2, 4}, {1, 2, 4}}, {2, 3, 4, 5});
     ChainLinkStats stats;
     const std::vector<Tri> kept = KeepChainLinks(p, is_curve, tent, &stats);
-    EXPECT_EQ(stats.tents, 1u);
+    EXPECT_EQ(stats.flips, 1u);
     const std::set<Tri> k(kept.begin(), kept.end());
     for (int s = 2; s < 6; ++s) EXPECT_TRUE(k.count({0, 1, s})) << "the link's triangle on half-plane " << s;
     EXPECT_FALSE(k.count({0, 2, 4}) || k.count({1, 2, 4}));
@@ -202,7 +207,23 @@ TEST(ChainLinks, ATentOverALinkIsFlippedOntoTheLink) {
     std::vector<Vec3> same_side = p;
     same_side[4] = {0.45, 0.5, 0.2};
     EXPECT_EQ(KeepChainLinks(same_side, is_curve, tent, &stats), tent);
-    EXPECT_EQ(stats.tents, 0u);
+    EXPECT_EQ(stats.flips, 0u);
+  }
+}
+
+// A gap of the chain where three sheets meet: curve seeds 0 and 1 share no triple (sheet seed 4's region
+// reached the curve between them), and seeds 2, 4 and 5 of three half-planes span the junction as a double
+// pyramid with apexes 0 and 1 on the triangle (2, 4, 5). It becomes the link with one triangle per sheet.
+TEST(ChainLinks, AGapWhereThreeSheetsMeetIsSpannedByItsLink) {
+  const std::vector<uint8_t> is_curve = {1, 1, 0, 0, 0, 0, 1, 1};
+  for (uint64_t seed = 1; seed <= 10; ++seed) {
+    const std::vector<Vec3> p = CrossingCluster(0.05, seed);
+    const std::vector<Tri> gap =
+        WithChainBeyond({{2, 4, 5}, {0, 2, 4}, {0, 4, 5}, {0, 2, 5}, {1, 2, 4}, {1, 4, 5}, {1, 2, 5}}, {2, 4, 5});
+    ChainLinkStats stats;
+    const std::vector<Tri> kept = KeepChainLinks(p, is_curve, gap, &stats);
+    EXPECT_EQ(stats.flips, 1u);
+    EXPECT_EQ(kept, WithChainBeyond({{0, 1, 2}, {0, 1, 4}, {0, 1, 5}}, {2, 4, 5}));
   }
 }
 

@@ -601,9 +601,9 @@ std::vector<Tri> DualTriangles(const Graph& graph, const std::vector<int>& label
       ChainLinkStats cl;
       faces = KeepChainLinks(seeds.position, is_curve, faces, &cl);
       monitor.Info(Format("chain links: %zu between curve seeds; %zu triples dropped (%zu jumps over a curve seed, "
-                          "split at it, and %zu tents over a link flipped onto it, with %zu triples the samples "
+                          "split at it, and %zu junctions spanned by their link, with %zu triples the samples "
                           "did not see; the rest across crossings)",
-                          cl.links, cl.dropped, cl.jumps, cl.tents, cl.added));
+                          cl.links, cl.dropped, cl.jumps, cl.flips, cl.added));
     }
   }
   return faces;

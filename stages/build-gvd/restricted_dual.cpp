@@ -254,32 +254,89 @@ void KeepLinksAcrossCrossings(const std::vector<Vec3>& seeds, const Chain& chain
   }
 }
 
-// A tent over a link cc': the triple (c, c', a) of one side's fan is there, the other side's sheet seed b is
-// joined to it across the link by (c, a, b) and (c', a, b), and (c, c', b) is missing (a's region reached
-// past the chain between c and c', so the samples saw a and b meet there). The two triples on ab become
-// (c, c', b) (KeepChainLinks).
-size_t FlipTentsOntoLinks(const std::vector<Vec3>& seeds, const Chain& chain, const std::vector<uint8_t>& is_curve,
-                          const std::vector<std::vector<int>>& neighbours, LiveTriples& live) {
+// Two curve seeds farther apart than this x the mean edge of the dual are no link of one chain: optimize-seeds
+// fills gaps above 1.5 spacings (--feature-gap-max), so a link is at most that long.
+constexpr double kMaxLinkSpacings = 1.5;
+
+// Where a chain's link is missing or incomplete, the sheet seeds beside it span the junction instead: two
+// curve seeds c, d, consecutive on a chain (no curve seed, neighbour of both, inside the sphere on cd) and at
+// most kMaxLinkSpacings apart, both make triples with the same pairs of sheet seeds S around cd — a
+// diagonal ab across the chain, or where three sheets meet at a gap a double pyramid on (a, b, e) — and some
+// (c, d, s) is not there. Where the seeds of each pair lie on two sides of cd, those triples and the ones
+// among S become one triple (c, d, s) per sheet seed: the link, with each sheet's triangle on it
+// (KeepChainLinks).
+size_t SpanJunctionsByTheirLinks(const std::vector<Vec3>& seeds, const Chain& chain, const std::vector<uint8_t>& is_curve,
+                                 const std::vector<std::vector<int>>& neighbours, const std::vector<Tri>& triples,
+                                 LiveTriples& live) {
+  if (chain.links.empty() || triples.empty()) return 0;
+  // The spacing: the mean length of the dual's edges (each triple's three, so an edge counts per triple).
+  double edge_sum = 0.0;
+  for (const Tri& t : triples)
+    for (int k = 0; k < 3; ++k) edge_sum += (seeds[static_cast<size_t>(t[k])] - seeds[static_cast<size_t>(t[(k + 1) % 3])]).norm();
+  const double max_link = kMaxLinkSpacings * edge_sum / (3.0 * static_cast<double>(triples.size()));
   const double max_same_side_cos = std::cos(kLinkSideAngleDeg * M_PI / 180.0);
-  size_t flipped = 0;
-  for (const auto& [c, d] : chain.links) {
-    const Vec3 axis = (seeds[static_cast<size_t>(d)] - seeds[static_cast<size_t>(c)]).normalized();
-    auto across = [&](int x) {
-      return AcrossLine(seeds[static_cast<size_t>(c)], axis, seeds[static_cast<size_t>(x)]);
-    };
-    for (int a : live.Thirds(c, d, neighbours)) {
-      if (is_curve[static_cast<size_t>(a)]) continue;
-      for (int b : live.Thirds(c, a, neighbours)) {
-        if (is_curve[static_cast<size_t>(b)] || b == d || live.Has(c, d, b) || !live.Has(d, a, b)) continue;
-        if (live.OnEdge(a, b) != 2 || !(across(a).dot(across(b)) < max_same_side_cos)) continue;
-        if (live.ReplaceUnlessItOpens({SortedTri({c, a, b}), SortedTri({d, a, b})}, {SortedTri({c, d, b})})) {
-          ++flipped;
-          break;  // a's triples changed: its next link
-        }
-      }
-    }
+  // Candidate pairs: curve seeds with a common sheet neighbour, near enough.
+  std::vector<std::array<int, 2>> pairs;
+  for (size_t si = 0; si < seeds.size(); ++si) {
+    if (is_curve[si]) continue;
+    const auto& ns = neighbours[si];
+    for (size_t i = 0; i < ns.size(); ++i)
+      for (size_t j = i + 1; j < ns.size(); ++j)
+        if (is_curve[static_cast<size_t>(ns[i])] && is_curve[static_cast<size_t>(ns[j])] &&
+            (seeds[static_cast<size_t>(ns[i])] - seeds[static_cast<size_t>(ns[j])]).norm() <= max_link)
+          pairs.push_back({ns[i], ns[j]});
   }
-  return flipped;
+  std::sort(pairs.begin(), pairs.end());
+  pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
+  size_t spanned = 0;
+  std::vector<int> common;
+  for (const auto& [c, d] : pairs) {
+    common.clear();
+    const auto &nc = neighbours[static_cast<size_t>(c)], &nd = neighbours[static_cast<size_t>(d)];
+    std::set_intersection(nc.begin(), nc.end(), nd.begin(), nd.end(), std::back_inserter(common));
+    const Vec3 &pc = seeds[static_cast<size_t>(c)], &pd = seeds[static_cast<size_t>(d)];
+    bool between = false;
+    std::vector<int> sheet;
+    for (int w : common) {
+      const Vec3& pw = seeds[static_cast<size_t>(w)];
+      if (is_curve[static_cast<size_t>(w)]) between = between || (pc - pw).dot(pd - pw) < 0.0;
+      else sheet.push_back(w);
+    }
+    if (between || sheet.size() < 2) continue;
+    // The pairs of S that c spans, and that d spans: the same, and each across cd.
+    const Vec3 axis = (pd - pc).normalized();
+    std::vector<Tri> drop;
+    std::vector<int> used;
+    bool same = true, across = true, link_whole = true;
+    for (size_t i = 0; i < sheet.size() && same; ++i)
+      for (size_t j = i + 1; j < sheet.size() && same; ++j) {
+        const int a = sheet[i], b = sheet[j];
+        const bool by_c = live.Has(c, a, b), by_d = live.Has(d, a, b);
+        same = by_c == by_d;
+        if (!by_c || !same) continue;
+        drop.push_back(SortedTri({c, a, b}));
+        drop.push_back(SortedTri({d, a, b}));
+        used.push_back(a);
+        used.push_back(b);
+        across = across && AcrossLine(pc, axis, seeds[static_cast<size_t>(a)]).dot(AcrossLine(pc, axis, seeds[static_cast<size_t>(b)])) <
+                               max_same_side_cos;
+      }
+    if (!same || !across || drop.empty()) continue;
+    std::sort(used.begin(), used.end());
+    used.erase(std::unique(used.begin(), used.end()), used.end());
+    std::vector<Tri> add;
+    for (int s : used) {
+      link_whole = link_whole && live.Has(c, d, s);
+      add.push_back(SortedTri({c, d, s}));
+    }
+    if (link_whole) continue;  // a closed junction on a whole link: the crossing rule's or thin-mesh's
+    for (size_t i = 0; i < used.size(); ++i)
+      for (size_t j = i + 1; j < used.size(); ++j)
+        for (size_t k = j + 1; k < used.size(); ++k)
+          if (live.Has(used[i], used[j], used[k])) drop.push_back(SortedTri({used[i], used[j], used[k]}));
+    spanned += live.ReplaceUnlessItOpens(drop, add);
+  }
+  return spanned;
 }
 
 }  // namespace
@@ -293,7 +350,7 @@ std::vector<Tri> KeepChainLinks(const std::vector<Vec3>& seeds, const std::vecto
   LiveTriples live(triples);
   stats.jumps = DropChainJumps(seeds, is_curve, chain, neighbours, live);
   KeepLinksAcrossCrossings(seeds, chain, is_curve, neighbours, live);
-  stats.tents = FlipTentsOntoLinks(seeds, chain, is_curve, neighbours, live);
+  stats.flips = SpanJunctionsByTheirLinks(seeds, chain, is_curve, neighbours, triples, live);
   std::vector<Tri> kept;
   kept.reserve(triples.size());
   for (const Tri& t : triples)

@@ -58,8 +58,8 @@ struct ChainLinkStats {
   size_t links = 0;    ///< chain links found between curve seeds
   size_t jumps = 0;    ///< jumps over a curve seed whose triples were dropped
   size_t dropped = 0;  ///< triples dropped in all
-  size_t added = 0;    ///< triples the splits of jumps and the tent flips added (not witnessed)
-  size_t tents = 0;    ///< tents over a link flipped onto it
+  size_t added = 0;    ///< triples the splits of jumps and the flips added (not witnessed)
+  size_t flips = 0;    ///< junctions spanned by their link instead of by sheet seeds across it
 };
 
 /// The triples that follow the feature chains instead of jumping along or across them. A *chain link* is a
@@ -80,12 +80,15 @@ struct ChainLinkStats {
 ///    the chain, the triples on ab cut across the curve; no chart decides there (the four seeds span two
 ///    planes), and thin-mesh's pair rule needs an edge of exactly two triples (an edge of two, across a
 ///    crease, is left to it).
-///  - **tents**: where (c, c', a), (c, a, b) and (c', a, b) are present and (c, c', b) is not, a and b are sheet
-///    seeds on two sides of the link and ab carries just those two triples, the two on ab become (c, c', b):
-///    a's region reached past the chain between c and c', and b's triangle on the link went unseen.
+///  - **junctions spanned by their link**: two curve seeds c, c' at most 1.5 mean dual edges apart, with no
+///    curve seed that is a neighbour of both inside the sphere with diameter cc', make triples with the same
+///    pairs of sheet seeds S, each pair on two sides of cc' (more than 60 degrees), and some (c, c', s) is
+///    missing: a sheet seed's region reached the curve between c and c' (a diagonal ab across the chain with
+///    (c, a, b) and (c', a, b); where three sheets meet at a gap, a double pyramid on a triple of S). Those
+///    triples and the ones among S become (c, c', s) for every s in S: the link, one triangle per sheet.
 ///
 /// Invariant: a triple is dropped only where the triples that replace it are present or added (a jump's
-/// halves cover its triangle but for the sliver along the chain, a tent's the link's triangle on b's side), and a change that would leave any edge
+/// halves cover its triangle but for the sliver along the chain, a junction's the link's triangles), and a change that would leave any edge
 /// with one triple where it had more is not made: no new boundary edge appears, so no hole opens. Jumps and
 /// links are taken in seed order on the live triples (deterministic).
 ///
