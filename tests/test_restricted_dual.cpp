@@ -224,6 +224,15 @@ TEST(ChainLinks, AGapWhereThreeSheetsMeetIsSpannedByItsLink) {
     const std::vector<Tri> kept = KeepChainLinks(p, is_curve, gap, &stats);
     EXPECT_EQ(stats.flips, 1u);
     EXPECT_EQ(kept, WithChainBeyond({{0, 1, 2}, {0, 1, 4}, {0, 1, 5}}, {2, 4, 5}));
+    // Apex 1 spans only two of the three pairs; the third, (2, 5), is closed by the triangle among the sheet
+    // seeds: the same junction, the same link.
+    const std::vector<Tri> lopsided =
+        WithChainBeyond({{2, 4, 5}, {0, 2, 4}, {0, 4, 5}, {0, 2, 5}, {1, 2, 4}, {1, 4, 5}}, {2, 4, 5});
+    EXPECT_EQ(KeepChainLinks(p, is_curve, lopsided, &stats), WithChainBeyond({{0, 1, 2}, {0, 1, 4}, {0, 1, 5}}, {2, 4, 5}));
+    // Without that triangle the pair (2, 5) is open on apex 1's side: no junction to span, left as it is.
+    std::vector<Tri> open = lopsided;
+    open.erase(std::find(open.begin(), open.end(), Tri{2, 4, 5}));
+    EXPECT_EQ(KeepChainLinks(p, is_curve, open, &stats), open);
   }
 }
 

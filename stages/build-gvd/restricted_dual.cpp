@@ -260,11 +260,11 @@ constexpr double kMaxLinkSpacings = 1.5;
 
 // Where a chain's link is missing or incomplete, the sheet seeds beside it span the junction instead: two
 // curve seeds c, d, consecutive on a chain (no curve seed, neighbour of both, inside the sphere on cd) and at
-// most kMaxLinkSpacings apart, both make triples with the same pairs of sheet seeds S around cd — a
-// diagonal ab across the chain, or where three sheets meet at a gap a double pyramid on (a, b, e) — and some
-// (c, d, s) is not there. Where the seeds of each pair lie on two sides of cd, those triples and the ones
-// among S become one triple (c, d, s) per sheet seed: the link, with each sheet's triangle on it
-// (KeepChainLinks).
+// most kMaxLinkSpacings apart, make triples with pairs of sheet seeds S around cd (one pair at least with
+// both, a pair with one only closed by a triple among S) — a diagonal ab across the chain, or where three
+// sheets meet at a gap a double pyramid on (a, b, e) — and some (c, d, s) is not there. Where the seeds of
+// each pair lie on two sides of cd, those triples and the ones among S become one triple (c, d, s) per sheet
+// seed: the link, with each sheet's triangle on it (KeepChainLinks).
 size_t SpanJunctionsByTheirLinks(const std::vector<Vec3>& seeds, const Chain& chain, const std::vector<uint8_t>& is_curve,
                                  const std::vector<std::vector<int>>& neighbours, const std::vector<Tri>& triples,
                                  LiveTriples& live) {
@@ -303,25 +303,28 @@ size_t SpanJunctionsByTheirLinks(const std::vector<Vec3>& seeds, const Chain& ch
       else sheet.push_back(w);
     }
     if (between || sheet.size() < 2) continue;
-    // The pairs of S that c spans, and that d spans: the same, and each across cd.
+    // The pairs of S that c or d spans, each across cd, at least one by both; a pair spanned by one of them
+    // only must be closed by a triple among S (the other apex's side of the junction is that triangle).
     const Vec3 axis = (pd - pc).normalized();
     std::vector<Tri> drop;
     std::vector<int> used;
-    bool same = true, across = true, link_whole = true;
-    for (size_t i = 0; i < sheet.size() && same; ++i)
-      for (size_t j = i + 1; j < sheet.size() && same; ++j) {
+    bool closed = true, across = true, shared = false, link_whole = true;
+    for (size_t i = 0; i < sheet.size() && closed; ++i)
+      for (size_t j = i + 1; j < sheet.size() && closed; ++j) {
         const int a = sheet[i], b = sheet[j];
         const bool by_c = live.Has(c, a, b), by_d = live.Has(d, a, b);
-        same = by_c == by_d;
-        if (!by_c || !same) continue;
-        drop.push_back(SortedTri({c, a, b}));
-        drop.push_back(SortedTri({d, a, b}));
+        if (!by_c && !by_d) continue;
+        if (by_c != by_d)
+          closed = std::any_of(sheet.begin(), sheet.end(), [&](int e) { return e != a && e != b && live.Has(a, b, e); });
+        shared = shared || (by_c && by_d);
+        if (by_c) drop.push_back(SortedTri({c, a, b}));
+        if (by_d) drop.push_back(SortedTri({d, a, b}));
         used.push_back(a);
         used.push_back(b);
         across = across && AcrossLine(pc, axis, seeds[static_cast<size_t>(a)]).dot(AcrossLine(pc, axis, seeds[static_cast<size_t>(b)])) <
                                max_same_side_cos;
       }
-    if (!same || !across || drop.empty()) continue;
+    if (!closed || !across || !shared) continue;
     std::sort(used.begin(), used.end());
     used.erase(std::unique(used.begin(), used.end()), used.end());
     std::vector<Tri> add;

@@ -81,11 +81,12 @@ struct ChainLinkStats {
 ///    planes), and thin-mesh's pair rule needs an edge of exactly two triples (an edge of two, across a
 ///    crease, is left to it).
 ///  - **junctions spanned by their link**: two curve seeds c, c' at most 1.5 mean dual edges apart, with no
-///    curve seed that is a neighbour of both inside the sphere with diameter cc', make triples with the same
-///    pairs of sheet seeds S, each pair on two sides of cc' (more than 60 degrees), and some (c, c', s) is
-///    missing: a sheet seed's region reached the curve between c and c' (a diagonal ab across the chain with
-///    (c, a, b) and (c', a, b); where three sheets meet at a gap, a double pyramid on a triple of S). Those
-///    triples and the ones among S become (c, c', s) for every s in S: the link, one triangle per sheet.
+///    curve seed that is a neighbour of both inside the sphere with diameter cc', make triples with pairs of
+///    sheet seeds S (at least one pair with both; a pair with one of them only closed by a triple among S),
+///    each pair on two sides of cc' (more than 60 degrees), and some (c, c', s) is missing: a sheet seed's
+///    region reached the curve between c and c' (a diagonal ab across the chain with (c, a, b) and
+///    (c', a, b); where three sheets meet at a gap, a double pyramid on a triple of S). Those triples and the
+///    ones among S become (c, c', s) for every s in S: the link, one triangle per sheet.
 ///
 /// Invariant: a triple is dropped only where the triples that replace it are present or added (a jump's
 /// halves cover its triangle but for the sliver along the chain, a junction's the link's triangles), and a change that would leave any edge
