@@ -193,7 +193,7 @@ TEST(ChainLinks, ATentOverALinkIsFlippedOntoTheLink) {
     const std::vector<Tri> tent = WithChainBeyond({{0, 1, 2}, {0, 1, 3}, {0, 1, 5}, {0, 2, 4}, {1, 2, 4}}, {2, 3, 4, 5});
     ChainLinkStats stats;
     const std::vector<Tri> kept = KeepChainLinks(p, is_curve, tent, &stats);
-    EXPECT_EQ(stats.flips, 1u);
+    EXPECT_EQ(stats.junctions, 1u);
     const std::set<Tri> k(kept.begin(), kept.end());
     for (int s = 2; s < 6; ++s) EXPECT_TRUE(k.count({0, 1, s})) << "the link's triangle on half-plane " << s;
     EXPECT_FALSE(k.count({0, 2, 4}) || k.count({1, 2, 4}));
@@ -207,7 +207,7 @@ TEST(ChainLinks, ATentOverALinkIsFlippedOntoTheLink) {
     std::vector<Vec3> same_side = p;
     same_side[4] = {0.45, 0.5, 0.2};
     EXPECT_EQ(KeepChainLinks(same_side, is_curve, tent, &stats), tent);
-    EXPECT_EQ(stats.flips, 0u);
+    EXPECT_EQ(stats.junctions, 0u);
   }
 }
 
@@ -222,7 +222,7 @@ TEST(ChainLinks, AGapWhereThreeSheetsMeetIsSpannedByItsLink) {
         WithChainBeyond({{2, 4, 5}, {0, 2, 4}, {0, 4, 5}, {0, 2, 5}, {1, 2, 4}, {1, 4, 5}, {1, 2, 5}}, {2, 4, 5});
     ChainLinkStats stats;
     const std::vector<Tri> kept = KeepChainLinks(p, is_curve, gap, &stats);
-    EXPECT_EQ(stats.flips, 1u);
+    EXPECT_EQ(stats.junctions, 1u);
     EXPECT_EQ(kept, WithChainBeyond({{0, 1, 2}, {0, 1, 4}, {0, 1, 5}}, {2, 4, 5}));
     // Apex 1 spans only two of the three pairs; the third, (2, 5), is closed by the triangle among the sheet
     // seeds: the same junction, the same link.

@@ -603,7 +603,7 @@ std::vector<Tri> DualTriangles(const Graph& graph, const std::vector<int>& label
       monitor.Info(Format("chain links: %zu between curve seeds; %zu triples dropped (%zu jumps over a curve seed, "
                           "split at it, and %zu junctions spanned by their link, with %zu triples the samples "
                           "did not see; the rest across crossings)",
-                          cl.links, cl.dropped, cl.jumps, cl.flips, cl.added));
+                          cl.links, cl.dropped, cl.jumps, cl.junctions, cl.added));
     }
   }
   return faces;

@@ -92,29 +92,34 @@ std::vector<std::vector<int>> GeodesicNeighbours(size_t num_seeds, const std::ve
 // two sides of a sheet's curve) when the directions from the link to them, across it, differ by more than
 // this: on one side of it (one face, a curved one included) they lie within a few tens of degrees.
 constexpr double kLinkSideAngleDeg = 60.0;
+const double kLinkSideMaxCos = std::cos(kLinkSideAngleDeg * M_PI / 180.0);
 
-// The chain links among the curve seeds (KeepChainLinks): geodesic neighbours with no common curve neighbour
-// strictly inside the sphere on their segment.
+// Whether curve seeds c and d are consecutive on a chain: no curve seed among their common geodesic
+// neighbours (left in *common) lies strictly inside the sphere on cd (the Gabriel rule).
+bool Consecutive(const std::vector<Vec3>& seeds, const std::vector<uint8_t>& is_curve,
+                 const std::vector<std::vector<int>>& neighbours, int c, int d, std::vector<int>* common) {
+  const auto &nc = neighbours[static_cast<size_t>(c)], &nd = neighbours[static_cast<size_t>(d)];
+  common->clear();
+  std::set_intersection(nc.begin(), nc.end(), nd.begin(), nd.end(), std::back_inserter(*common));
+  const Vec3 &pc = seeds[static_cast<size_t>(c)], &pd = seeds[static_cast<size_t>(d)];
+  for (int w : *common) {
+    const Vec3& pw = seeds[static_cast<size_t>(w)];
+    if (is_curve[static_cast<size_t>(w)] && (pc - pw).dot(pd - pw) < 0.0) return false;
+  }
+  return true;
+}
+
+// The chain links among the curve seeds (KeepChainLinks): consecutive geodesic neighbours.
 std::vector<std::array<int, 2>> ChainLinks(const std::vector<Vec3>& seeds, const std::vector<uint8_t>& is_curve,
                                            const std::vector<std::vector<int>>& neighbours) {
   std::vector<std::array<int, 2>> links;
   std::vector<int> common;
   for (size_t c = 0; c < seeds.size(); ++c) {
     if (!is_curve[c]) continue;
-    for (int d : neighbours[c]) {
-      if (d <= static_cast<int>(c) || !is_curve[static_cast<size_t>(d)]) continue;
-      const auto& nd = neighbours[static_cast<size_t>(d)];
-      common.clear();
-      std::set_intersection(neighbours[c].begin(), neighbours[c].end(), nd.begin(), nd.end(),
-                            std::back_inserter(common));
-      const Vec3 &pc = seeds[c], &pd = seeds[static_cast<size_t>(d)];
-      bool between = false;
-      for (int w : common) {
-        const Vec3& pw = seeds[static_cast<size_t>(w)];
-        between = between || (is_curve[static_cast<size_t>(w)] && (pc - pw).dot(pd - pw) < 0.0);
-      }
-      if (!between) links.push_back({static_cast<int>(c), d});
-    }
+    for (int d : neighbours[c])
+      if (d > static_cast<int>(c) && is_curve[static_cast<size_t>(d)] &&
+          Consecutive(seeds, is_curve, neighbours, static_cast<int>(c), d, &common))
+        links.push_back({static_cast<int>(c), d});
   }
   return links;
 }
@@ -234,7 +239,6 @@ size_t DropChainJumps(const std::vector<Vec3>& seeds, const std::vector<uint8_t>
 // (KeepChainLinks).
 void KeepLinksAcrossCrossings(const std::vector<Vec3>& seeds, const Chain& chain, const std::vector<uint8_t>& is_curve,
                               const std::vector<std::vector<int>>& neighbours, LiveTriples& live) {
-  const double max_same_side_cos = std::cos(kLinkSideAngleDeg * M_PI / 180.0);
   for (const auto& [c, d] : chain.links) {
     const std::vector<int> third = live.Thirds(c, d, neighbours);
     const Vec3 axis = (seeds[static_cast<size_t>(d)] - seeds[static_cast<size_t>(c)]).normalized();
@@ -246,7 +250,7 @@ void KeepLinksAcrossCrossings(const std::vector<Vec3>& seeds, const Chain& chain
         const int a = third[i], b = third[j];
         // A curve seed on the link's tetrahedron is the chain going on (a jump's business) or another chain.
         if (is_curve[static_cast<size_t>(a)] || is_curve[static_cast<size_t>(b)]) continue;
-        if (!(across(a).dot(across(b)) < max_same_side_cos)) continue;  // one side of the link: a chart's business
+        if (!(across(a).dot(across(b)) < kLinkSideMaxCos)) continue;  // one side of the link: a chart's business
         // Only where ab is shared by 4+ triples: an edge of 2 (across a crease) thin-mesh's pair rule decides.
         if (!live.Has(c, a, b) || !live.Has(d, a, b) || live.OnEdge(a, b) < 4) continue;
         live.DropUnlessItOpens({SortedTri({c, a, b}), SortedTri({d, a, b})});
@@ -274,7 +278,6 @@ size_t SpanJunctionsByTheirLinks(const std::vector<Vec3>& seeds, const Chain& ch
   for (const Tri& t : triples)
     for (int k = 0; k < 3; ++k) edge_sum += (seeds[static_cast<size_t>(t[k])] - seeds[static_cast<size_t>(t[(k + 1) % 3])]).norm();
   const double max_link = kMaxLinkSpacings * edge_sum / (3.0 * static_cast<double>(triples.size()));
-  const double max_same_side_cos = std::cos(kLinkSideAngleDeg * M_PI / 180.0);
   // Candidate pairs: curve seeds with a common sheet neighbour, near enough.
   std::vector<std::array<int, 2>> pairs;
   for (size_t si = 0; si < seeds.size(); ++si) {
@@ -291,18 +294,12 @@ size_t SpanJunctionsByTheirLinks(const std::vector<Vec3>& seeds, const Chain& ch
   size_t spanned = 0;
   std::vector<int> common;
   for (const auto& [c, d] : pairs) {
-    common.clear();
-    const auto &nc = neighbours[static_cast<size_t>(c)], &nd = neighbours[static_cast<size_t>(d)];
-    std::set_intersection(nc.begin(), nc.end(), nd.begin(), nd.end(), std::back_inserter(common));
-    const Vec3 &pc = seeds[static_cast<size_t>(c)], &pd = seeds[static_cast<size_t>(d)];
-    bool between = false;
+    if (!Consecutive(seeds, is_curve, neighbours, c, d, &common)) continue;
     std::vector<int> sheet;
-    for (int w : common) {
-      const Vec3& pw = seeds[static_cast<size_t>(w)];
-      if (is_curve[static_cast<size_t>(w)]) between = between || (pc - pw).dot(pd - pw) < 0.0;
-      else sheet.push_back(w);
-    }
-    if (between || sheet.size() < 2) continue;
+    for (int w : common)
+      if (!is_curve[static_cast<size_t>(w)]) sheet.push_back(w);
+    if (sheet.size() < 2) continue;
+    const Vec3 &pc = seeds[static_cast<size_t>(c)], &pd = seeds[static_cast<size_t>(d)];
     // The pairs of S that c or d spans, each across cd, at least one by both; a pair spanned by one of them
     // only must be closed by a triple among S (the other apex's side of the junction is that triangle).
     const Vec3 axis = (pd - pc).normalized();
@@ -322,7 +319,7 @@ size_t SpanJunctionsByTheirLinks(const std::vector<Vec3>& seeds, const Chain& ch
         used.push_back(a);
         used.push_back(b);
         across = across && AcrossLine(pc, axis, seeds[static_cast<size_t>(a)]).dot(AcrossLine(pc, axis, seeds[static_cast<size_t>(b)])) <
-                               max_same_side_cos;
+                               kLinkSideMaxCos;
       }
     if (!closed || !across || !shared) continue;
     std::sort(used.begin(), used.end());
@@ -353,7 +350,7 @@ std::vector<Tri> KeepChainLinks(const std::vector<Vec3>& seeds, const std::vecto
   LiveTriples live(triples);
   stats.jumps = DropChainJumps(seeds, is_curve, chain, neighbours, live);
   KeepLinksAcrossCrossings(seeds, chain, is_curve, neighbours, live);
-  stats.flips = SpanJunctionsByTheirLinks(seeds, chain, is_curve, neighbours, triples, live);
+  stats.junctions = SpanJunctionsByTheirLinks(seeds, chain, is_curve, neighbours, triples, live);
   std::vector<Tri> kept;
   kept.reserve(triples.size());
   for (const Tri& t : triples)

@@ -58,8 +58,8 @@ struct ChainLinkStats {
   size_t links = 0;    ///< chain links found between curve seeds
   size_t jumps = 0;    ///< jumps over a curve seed whose triples were dropped
   size_t dropped = 0;  ///< triples dropped in all
-  size_t added = 0;    ///< triples the splits of jumps and the flips added (not witnessed)
-  size_t flips = 0;    ///< junctions spanned by their link instead of by sheet seeds across it
+  size_t added = 0;      ///< triples the splits of jumps and the spanned junctions added (not witnessed)
+  size_t junctions = 0;  ///< junctions spanned by their link instead of by sheet seeds across it
 };
 
 /// The triples that follow the feature chains instead of jumping along or across them. A *chain link* is a

@@ -56,10 +56,12 @@ std::vector<Vec3> DrawInBand(const Udf& udf, const Box& box, const SampleSeedsOp
   // share of the box, and each later one asks for what is still wanted at that rate, plus a fifth.
   constexpr double kPilot = 65536.0, kMinBatch = 4096.0;
   while (points.size() < options.count && next < max_candidates) {
-    const double rate = std::max(1e-4, static_cast<double>(points.size()) / static_cast<double>(next));
-    const size_t want = options.count - points.size();
-    const size_t n = next == 0 ? static_cast<size_t>(kPilot)
-                               : static_cast<size_t>(std::clamp(1.2 * static_cast<double>(want) / rate, kMinBatch, 1e7));
+    size_t n = static_cast<size_t>(kPilot);
+    if (next > 0) {
+      const double rate = std::max(1e-4, static_cast<double>(points.size()) / static_cast<double>(next));
+      const double want = static_cast<double>(options.count - points.size());
+      n = static_cast<size_t>(std::clamp(1.2 * want / rate, kMinBatch, 1e7));
+    }
     batch.resize(n);
     for (size_t k = 0; k < n; ++k) batch[k] = Candidate(box, options.seed, next + k);
     udf.Evaluate(batch, d, g);
