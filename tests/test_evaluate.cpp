@@ -125,6 +125,15 @@ TriangleMesh Transformed(const TriangleMesh& m, double scale, const Vec3& shift)
   return t;
 }
 
+// Both meshes' faces over both vertex sets, sharing no vertex: two parts modelled separately.
+TriangleMesh Parts(const TriangleMesh& a, const TriangleMesh& b) {
+  TriangleMesh m = a;
+  const int base = static_cast<int>(m.vertices.size());
+  m.vertices.insert(m.vertices.end(), b.vertices.begin(), b.vertices.end());
+  for (const Tri& t : b.faces) m.faces.push_back({base + t[0], base + t[1], base + t[2]});
+  return m;
+}
+
 Metrics Eval(const TriangleMesh& mesh, const TriangleMesh& ref, EvaluateOptions options = {}) {
   return Evaluate(mesh, ref, options, Monitor::Null());
 }
@@ -480,6 +489,29 @@ TEST(EvaluateFeatures, ANotchInTheRimGivesItsDepth) {
   EXPECT_EQ(Eval(Square(4), Square(4)).features.boundary_recall, 1.0);
 }
 
+TEST(EvaluateFeatures, AnUnweldedSeamIsNotARimTwoRimsApartAre) {
+  // Two squares side by side, 4 x 4 and 3 x 3 cells: along x = 1 their vertices do not match (a T-seam that
+  // welding cannot close). The union is the 2 x 1 rectangle, whose rim is its outline; the seam is not one.
+  TriangleMesh rectangle = Square(8);
+  for (Vec3& p : rectangle.vertices) p.x() *= 2;
+  auto seamed = [](double gap) {  // the right square spans x in [1 + gap, 2]
+    TriangleMesh right = Square(3);
+    for (Vec3& p : right.vertices) p.x() = 1 + gap + (1 - gap) * p.x();
+    return Parts(Square(4), right);
+  };
+  const Metrics m = Eval(rectangle, seamed(0.0));
+  EXPECT_NEAR(m.features.boundary_length, 6 * m.frame.scale, 0.01 * m.frame.scale);
+  EXPECT_EQ(m.features.boundary_recall, 1.0);
+  EXPECT_LT(m.features.boundary_max_x1e3, 1e-6);
+  // A gap below the recall's tolerance is still a seam; four times that, two rims facing each other, which
+  // the rectangle does not have.
+  const double tolerance = m.features.tolerance / m.frame.scale;
+  EXPECT_EQ(Eval(rectangle, seamed(0.2 * tolerance)).features.boundary_recall, 1.0);
+  const Metrics apart = Eval(rectangle, seamed(4 * tolerance));
+  EXPECT_NEAR(apart.features.boundary_length, (8 - 2 * 4 * tolerance) * apart.frame.scale, 0.01 * apart.frame.scale);
+  EXPECT_NEAR(apart.features.boundary_recall, 0.75, 0.01);
+}
+
 // ---- ECD ----
 
 TEST(EvaluateEcd, SphereReferenceHasNoEdgePointsSoEcdIsZero) {
@@ -616,15 +648,6 @@ TEST(EvaluateNmcd, SamplesAreSpreadByLengthOverTheNonManifoldEdges) {
 
 // ---- the reference's crossing curves ----
 
-// Both meshes' faces over both vertex sets, sharing no vertex: two parts modelled separately.
-TriangleMesh Parts(const TriangleMesh& a, const TriangleMesh& b) {
-  TriangleMesh m = a;
-  const int base = static_cast<int>(m.vertices.size());
-  m.vertices.insert(m.vertices.end(), b.vertices.begin(), b.vertices.end());
-  for (const Tri& t : b.faces) m.faces.push_back({base + t[0], base + t[1], base + t[2]});
-  return m;
-}
-
 // Square(n) turned by `deg` degrees about the line y = 0.5, z = 0 (the x direction), then shifted along z.
 TriangleMesh Turned(int n, double deg, double dz = 0.0) {
   TriangleMesh m = Square(n);
@@ -731,6 +754,23 @@ TEST(EvaluateCrossings, APartLyingOnAnotherTangentiallyBranchesWhereNoTrianglesC
   for (Vec3& p : plate.vertices) p.z() *= 0.05;  // 0.05 thick, welded at the rims by Evaluate only
   EXPECT_EQ(BranchesAcross(WeldVertices(plate, 1e-9), {Vec3(0.1, 0.5, 0.0)}, {Vec3(1, 0, 0)}, 0.2, 0.002),
             std::vector<char>({0}));
+}
+
+TEST(EvaluateCrossings, ThePieceThroughARimLeavesOnceThroughASeamTwice) {
+  const std::vector<Vec3> along_x{Vec3(1, 0, 0)}, along_y{Vec3(0, 1, 0)};
+  EXPECT_EQ(ExitsThrough(Square(4), {Vec3(0.4, 0, 0)}, along_x, 0.1, 0.01), std::vector<size_t>{1});
+  EXPECT_EQ(ExitsThrough(Square(4), {Vec3(0.4, 0.4, 0)}, along_x, 0.1, 0.01), std::vector<size_t>{2});
+  EXPECT_EQ(ExitsThrough(Square(4), {Vec3(0.4, 0.4, 0.5)}, along_x, 0.1, 0.01), std::vector<size_t>{0});
+  // A T-seam, and the same two squares 0.005 apart (joined) and 0.05 apart (two rims).
+  for (double gap : {0.0, 0.005, 0.05}) {
+    const TriangleMesh seam = Parts(Square(4), Transformed(Square(3), 1.0, Vec3(1 + gap, 0, 0)));
+    EXPECT_EQ(ExitsThrough(seam, {Vec3(1, 0.4, 0)}, along_y, 0.1, 0.01), std::vector<size_t>{gap < 0.01 ? 2u : 1u})
+        << gap;
+  }
+  // A crease: the second square folded up at 90 degrees along the seam.
+  TriangleMesh up = Square(3);
+  for (Vec3& p : up.vertices) p = Vec3(1, p.y(), p.x());
+  EXPECT_EQ(ExitsThrough(Parts(Square(4), up), {Vec3(1, 0.4, 0)}, along_y, 0.1, 0.01), std::vector<size_t>{2});
 }
 
 TEST(EvaluateCrossings, AMeshThatBranchesWhereTheReferencesPartsTouchTangentiallyIsNotSpurious) {

@@ -289,11 +289,16 @@ size_t DistinctExits(std::vector<double> angles, double min_gap) {
   return distinct;
 }
 
-}  // namespace
-
-std::vector<char> BranchesAcross(const TriangleMesh& mesh, const std::vector<Vec3>& points,
-                                 const std::vector<Vec3>& directions, double radius, double join) {
-  std::vector<char> out(points.size(), 0);
+// The cross-section of the union of `mesh`'s triangles by the plane through each point normal to its
+// direction, within the disc of `radius`: its pieces, joined where closer than `join`, each joined piece as
+// its distinct exits from the disc and whether it passes within `join` of the centre.
+struct Section {
+  std::vector<size_t> exits;
+  std::vector<char> through_centre;
+};
+std::vector<Section> CrossSections(const TriangleMesh& mesh, const std::vector<Vec3>& points,
+                                   const std::vector<Vec3>& directions, double radius, double join) {
+  std::vector<Section> out(points.size());
   if (points.empty()) return out;
   std::vector<FaceBox> faces, queries;
   for (size_t f = 0; f < mesh.faces.size(); ++f) faces.push_back(BoxOfFace(mesh, f, 0.0));
@@ -333,13 +338,39 @@ std::vector<char> BranchesAcross(const TriangleMesh& mesh, const std::vector<Vec
         if (SegmentDistance(pieces[a][0], pieces[a][1], pieces[b][0], pieces[b][1]) <= join)
           sets.Union(static_cast<int>(a), static_cast<int>(b));
     std::vector<std::vector<double>> by_set(pieces.size());
+    std::vector<char> centre(pieces.size(), 0);
     for (size_t a = 0; a < pieces.size(); ++a) {
-      auto& into = by_set[static_cast<size_t>(sets.Find(static_cast<int>(a)))];
-      into.insert(into.end(), exits[a].begin(), exits[a].end());
+      const size_t set = static_cast<size_t>(sets.Find(static_cast<int>(a)));
+      by_set[set].insert(by_set[set].end(), exits[a].begin(), exits[a].end());
+      if (SegmentDistance(pieces[a][0], pieces[a][1], Vec2::Zero(), Vec2::Zero()) <= join) centre[set] = 1;
     }
-    for (const auto& angles : by_set)
-      if (DistinctExits(angles, min_gap) >= 3) out[i] = 1;
+    for (size_t set = 0; set < pieces.size(); ++set) {
+      if (static_cast<size_t>(sets.Find(static_cast<int>(set))) != set) continue;
+      out[i].exits.push_back(DistinctExits(by_set[set], min_gap));
+      out[i].through_centre.push_back(centre[set]);
+    }
   }
+  return out;
+}
+
+}  // namespace
+
+std::vector<char> BranchesAcross(const TriangleMesh& mesh, const std::vector<Vec3>& points,
+                                 const std::vector<Vec3>& directions, double radius, double join) {
+  const std::vector<Section> sections = CrossSections(mesh, points, directions, radius, join);
+  std::vector<char> out(points.size(), 0);
+  for (size_t i = 0; i < points.size(); ++i)
+    for (size_t exits : sections[i].exits) out[i] = out[i] || exits >= 3;
+  return out;
+}
+
+std::vector<size_t> ExitsThrough(const TriangleMesh& mesh, const std::vector<Vec3>& points,
+                                 const std::vector<Vec3>& directions, double radius, double join) {
+  const std::vector<Section> sections = CrossSections(mesh, points, directions, radius, join);
+  std::vector<size_t> out(points.size(), 0);
+  for (size_t i = 0; i < points.size(); ++i)
+    for (size_t k = 0; k < sections[i].exits.size(); ++k)
+      if (sections[i].through_centre[k]) out[i] = std::max(out[i], sections[i].exits[k]);
   return out;
 }
 

@@ -48,4 +48,13 @@ CurveSegments CrossingCurves(const TriangleMesh& mesh, double tolerance, double 
 std::vector<char> BranchesAcross(const TriangleMesh& mesh, const std::vector<Vec3>& points,
                                  const std::vector<Vec3>& directions, double radius, double join);
 
+/// For each point, the distinct exits from the disc (as in BranchesAcross, same `radius` and `join`) of the
+/// cross-section's piece that passes within `join` of the point; 0 if none does. Across an open boundary
+/// (a rim) of the union the piece through a point on it leaves the disc once; across an unwelded seam (two
+/// faces ending on the same line, or one ending within `join` of another) it leaves twice, because the union
+/// goes on there. A piece that turns back inside the disc (a strip narrower than the radius) leaves 0 times.
+/// \pre points and directions (non-zero) of the same size; radius > join > 0
+std::vector<size_t> ExitsThrough(const TriangleMesh& mesh, const std::vector<Vec3>& points,
+                                 const std::vector<Vec3>& directions, double radius, double join);
+
 }  // namespace voroudf

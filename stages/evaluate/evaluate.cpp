@@ -336,7 +336,7 @@ std::vector<Edge> SharpEdges(const TriangleMesh& mesh, double cos_threshold) {
 }
 
 std::vector<Vec3> SampleEdges(const TriangleMesh& mesh, const std::vector<Edge>& edges, size_t count,
-                              double* total_length) {
+                              double* total_length, std::vector<Vec3>* directions) {
   std::vector<double> cumulative(edges.size());
   double total = 0;
   for (size_t e = 0; e < edges.size(); ++e) {
@@ -347,6 +347,7 @@ std::vector<Vec3> SampleEdges(const TriangleMesh& mesh, const std::vector<Edge>&
   std::vector<Vec3> points;
   if (!(total > 0) || count == 0) return points;
   points.resize(count);
+  if (directions) directions->resize(count);
   for (size_t k = 0; k < count; ++k) {
     const double s = (static_cast<double>(k) + 0.5) * total / static_cast<double>(count);
     size_t e = static_cast<size_t>(std::upper_bound(cumulative.begin(), cumulative.end(), s) - cumulative.begin());
@@ -357,6 +358,7 @@ std::vector<Vec3> SampleEdges(const TriangleMesh& mesh, const std::vector<Edge>&
     const double start = e == 0 ? 0.0 : cumulative[e - 1];
     const double t = length > 0 ? std::clamp((s - start) / length, 0.0, 1.0) : 0.0;
     points[k] = a + t * (b - a);
+    if (directions) (*directions)[k] = b - a;
   }
   return points;
 }

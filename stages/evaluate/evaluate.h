@@ -119,8 +119,9 @@ std::vector<Edge> SharpEdges(const TriangleMesh& mesh, double cos_threshold);
 /// `count` points spread evenly by arc length over `edges` (stratified: the point k sits at length
 /// (k + 1/2) L / count along the edges laid end to end, L their total length). Deterministic.
 /// \param total_length receives L (may be null). \returns an empty set if there is no edge or L = 0.
+/// \param directions receives each sample's edge direction b - a (may be null).
 std::vector<Vec3> SampleEdges(const TriangleMesh& mesh, const std::vector<Edge>& edges, size_t count,
-                              double* total_length);
+                              double* total_length, std::vector<Vec3>* directions = nullptr);
 
 /// SampleEdges over NonManifoldEdges(mesh).
 std::vector<Vec3> SampleNonManifoldEdges(const TriangleMesh& mesh, size_t count, double* total_length);

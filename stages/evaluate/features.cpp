@@ -5,6 +5,7 @@
 #include <limits>
 #include <map>
 
+#include "stages/evaluate/crossings.h"
 #include "stages/evaluate/evaluate.h"
 
 namespace voroudf {
@@ -31,10 +32,10 @@ struct Coverage {
   double share = 1, mean = 0, max = 0, length = 0;
   std::vector<Vec3> missed;  ///< the samples farther than the tolerance
 };
-Coverage Cover(const TriangleMesh& from, const std::vector<Edge>& edges, const TriangleMesh& to,
-               const std::vector<Edge>& targets, double tol, size_t samples, Monitor& monitor) {
+Coverage CoverPoints(const std::vector<Vec3>& points, double length, const TriangleMesh& to,
+                    const std::vector<Edge>& targets, double tol, Monitor& monitor) {
   Coverage c;
-  const std::vector<Vec3> points = SampleEdges(from, edges, samples, &c.length);
+  c.length = length;
   if (points.empty()) return c;
   if (targets.empty()) {
     c.share = 0;
@@ -56,8 +57,29 @@ Coverage Cover(const TriangleMesh& from, const std::vector<Edge>& edges, const T
   c.mean = sum / static_cast<double>(d.size());
   return c;
 }
+Coverage Cover(const TriangleMesh& from, const std::vector<Edge>& edges, const TriangleMesh& to,
+               const std::vector<Edge>& targets, double tol, size_t samples, Monitor& monitor) {
+  double length = 0;
+  const std::vector<Vec3> points = SampleEdges(from, edges, samples, &length);
+  return CoverPoints(points, length, to, targets, tol, monitor);
+}
 
 }  // namespace
+
+// The samples of the reference's boundary edges where its union ends (RimSamples in features.h).
+std::vector<Vec3> RimSamples(const TriangleMesh& ref, double tolerance, size_t samples, double* rim_length) {
+  std::vector<Vec3> along;
+  double length = 0;
+  const std::vector<Vec3> points = SampleEdges(ref, BoundaryEdges(ref), samples, &length, &along);
+  *rim_length = length;
+  if (points.empty() || !(tolerance > 0)) return points;
+  const std::vector<size_t> exits = ExitsThrough(ref, points, along, 2 * tolerance, tolerance);
+  std::vector<Vec3> rim;
+  for (size_t k = 0; k < points.size(); ++k)
+    if (exits[k] <= 1) rim.push_back(points[k]);
+  *rim_length = length * static_cast<double>(rim.size()) / static_cast<double>(points.size());
+  return rim;
+}
 
 double MedianEdgeLength(const TriangleMesh& m) {
   const EdgeFaces ef = BuildEdgeFaces(m.faces);
@@ -136,7 +158,9 @@ FeatureMetrics FeatureRecall(const TriangleMesh& mesh, const TriangleMesh& ref, 
     }();
     for (double d : DistancesToSegments(at, mesh.vertices, points, monitor)) f.corners_matched += d <= f.tolerance ? 1 : 0;
   }
-  const Coverage rim = Cover(ref, BoundaryEdges(ref), mesh, BoundaryEdges(mesh), f.tolerance, samples, monitor);
+  double rim_length = 0;
+  const std::vector<Vec3> rim_points = RimSamples(ref, f.tolerance, samples, &rim_length);
+  const Coverage rim = CoverPoints(rim_points, rim_length, mesh, BoundaryEdges(mesh), f.tolerance, monitor);
   f.boundary_length = rim.length;
   f.boundary_recall = rim.share;
   f.boundary_max_x1e3 = rim.max / diagonal * 1e3;

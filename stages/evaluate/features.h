@@ -25,6 +25,14 @@ std::vector<Edge> BoundaryEdges(const TriangleMesh& mesh);
 /// Vertices where 3 or more of `edges` meet.
 std::vector<int> Corners(const std::vector<Edge>& edges);
 
+/// Samples of `ref`'s boundary edges (SampleEdges, `samples` of them) that lie on a rim of the union of its
+/// triangles, the open boundary a UDF has: those whose cross-section piece leaves a disc of 2 x `tolerance`
+/// at most once (ExitsThrough, pieces within `tolerance` joined). Samples on an unwelded seam, where another
+/// face of the reference ends on or within `tolerance` of the same line, are not: the UDF's zero set goes on
+/// there, and a mesh that closes it is right. \param rim_length receives the boundary edges' length times
+/// the share of samples kept. All samples if `tolerance` is 0.
+std::vector<Vec3> RimSamples(const TriangleMesh& ref, double tolerance, size_t samples, double* rim_length);
+
 struct FeatureMetrics {
   double tolerance = 0;            ///< 0.1 x the mesh's median edge length: "on" a mesh edge or vertex
   double feature_length = 0;       ///< total length of the reference's feature edges
@@ -33,7 +41,7 @@ struct FeatureMetrics {
   double feature_max_x1e3 = 0;     ///< their maximum / reference diagonal, x1e3
   size_t corners = 0;              ///< reference corners (3+ feature edges meet)
   size_t corners_matched = 0;      ///< of those, with a mesh vertex within `tolerance`
-  double boundary_length = 0;      ///< total length of the reference's boundary edges
+  double boundary_length = 0;      ///< length of the reference's rims: its boundary edges where its union ends
   double boundary_recall = 1;      ///< share of it within `tolerance` of a mesh boundary edge (1 if none)
   double boundary_max_x1e3 = 0;    ///< largest distance of a reference boundary sample to the mesh's boundary edges / diagonal, x1e3
   std::vector<Vec3> missed;        ///< the reference's feature samples farther than `tolerance` from every mesh edge
