@@ -45,6 +45,9 @@ class Task {
   Monitor& monitor_;
 };
 
+/// printf into a std::string, for log messages (any length).
+std::string Format(const char* format, ...) __attribute__((format(printf, 1, 2)));
+
 /// Logs to stderr with the program name and elapsed time. Progress: a redrawn percentage on a terminal;
 /// otherwise one line per 10 % once a task has run for more than two seconds (so pipelines' logs stay short).
 class StderrMonitor : public Monitor {

@@ -6,11 +6,9 @@
 
 #include <algorithm>
 #include <array>
-#include <cstdarg>
 #include <cstdint>
 #include <limits>
 #include <cmath>
-#include <cstdio>
 #include <functional>
 #include <iterator>
 #include <unordered_map>
@@ -30,16 +28,6 @@ namespace voroudf {
 namespace {
 
 constexpr size_t kSweepRangeNodes = 32768;
-
-std::string Format(const char* fmt, ...) __attribute__((format(printf, 1, 2)));
-std::string Format(const char* fmt, ...) {
-  char buf[512];
-  va_list args;
-  va_start(args, fmt);
-  std::vsnprintf(buf, sizeof buf, fmt, args);
-  va_end(args);
-  return buf;
-}
 
 // The surface normal of every seed's Voronoi region, from the principal axes of its samples (the axis of
 // least spread), and whether the region is a sheet: its least spread at most `flatness` x its largest.

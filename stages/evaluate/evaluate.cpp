@@ -81,12 +81,6 @@ std::string JsonString(const std::string& s) {
   return out + "\"";
 }
 
-std::string Fmt(const char* format, double a, double b = 0, double c = 0) {
-  char buf[200];
-  std::snprintf(buf, sizeof buf, format, a, b, c);
-  return buf;
-}
-
 }  // namespace
 
 void EvaluateOptions::Check() const {
@@ -459,7 +453,7 @@ TriangleMesh ReferenceBranchingCurves(const TriangleMesh& ref_welded, const Eval
   }
   if (!crossing.edges.empty())
     monitor.Info("reference: " + std::to_string(crossing.edges.size()) +
-                 Fmt(" crossing segments of length %.6g where its triangles cross or touch (non-manifold in the "
+                 Format(" crossing segments of length %.6g where its triangles cross or touch (non-manifold in the "
                      "UDF)", m.ref_crossing_length));
   return curves;
 }
@@ -507,9 +501,9 @@ Metrics Evaluate(const TriangleMesh& mesh_in, const TriangleMesh& reference_in, 
   m.frame = ReferenceFrame(reference_in);
   const TriangleMesh ref = ApplyFrame(m.frame, reference_in);
   const TriangleMesh mesh = ApplyFrame(m.frame, mesh_in);
-  monitor.Info(Fmt("frame: reference bbox centre (%.6g, %.6g, %.6g)", m.frame.center.x(), m.frame.center.y(),
+  monitor.Info(Format("frame: reference bbox centre (%.6g, %.6g, %.6g)", m.frame.center.x(), m.frame.center.y(),
                    m.frame.center.z()) +
-               Fmt(", scale %.6g, normalised diagonal %.6g", m.frame.scale, m.frame.ref_diagonal));
+               Format(", scale %.6g, normalised diagonal %.6g", m.frame.scale, m.frame.ref_diagonal));
   if (!(TotalArea(ref) > 0)) throw InputError("reference", "has no face of non-zero area");
   if (!(TotalArea(mesh) > 0))
     throw NumericalError("the mesh under test has no face of non-zero area (" + std::to_string(mesh.faces.size()) +
@@ -543,8 +537,8 @@ Metrics Evaluate(const TriangleMesh& mesh_in, const TriangleMesh& reference_in, 
     const ChamferDistances c = Chamfer(ref_samples.points, mesh_samples.points, monitor);
     m.cd_x1e3 = c.SumOfMeans() * 1e3;
     m.hd_x1e3 = c.MaxOfMaxima() / m.frame.ref_diagonal * 1e3;
-    monitor.Info(Fmt("CD: mean ref->mesh %.6g + mean mesh->ref %.6g; HD: one-sided maxima %.6g", c.mean_ab, c.mean_ba,
-                     c.max_ab) + Fmt(" and %.6g", c.max_ba));
+    monitor.Info(Format("CD: mean ref->mesh %.6g + mean mesh->ref %.6g; HD: one-sided maxima %.6g", c.mean_ab, c.mean_ba,
+                     c.max_ab) + Format(" and %.6g", c.max_ba));
   }
 
   std::vector<Vec3> ref_edge, mesh_edge;
@@ -585,14 +579,14 @@ Metrics Evaluate(const TriangleMesh& mesh_in, const TriangleMesh& reference_in, 
     m.has_floor = true;
     m.floor = SampledFloor(ref, ref_samples, ref_edge, options, m.frame.ref_diagonal, monitor);
   }
-  monitor.Info(Fmt("exact: CD %.6g (x1e3)  HD %.6g (x1e3)  p99 %.6g (x1e3)", m.exact.cd_x1e3, m.exact.hd_x1e3,
-                   m.exact.p99_x1e3) + Fmt("  ECD %.6g (x1e2)", m.exact.ecd_x1e2));
-  monitor.Info(Fmt("features: recall %.4g of length %.4g, corners ", m.features.recall, m.features.feature_length) +
+  monitor.Info(Format("exact: CD %.6g (x1e3)  HD %.6g (x1e3)  p99 %.6g (x1e3)", m.exact.cd_x1e3, m.exact.hd_x1e3,
+                   m.exact.p99_x1e3) + Format("  ECD %.6g (x1e2)", m.exact.ecd_x1e2));
+  monitor.Info(Format("features: recall %.4g of length %.4g, corners ", m.features.recall, m.features.feature_length) +
                std::to_string(m.features.corners_matched) + "/" + std::to_string(m.features.corners) +
-               Fmt(", boundary recall %.4g, boundary max %.4g (x1e3)", m.features.boundary_recall,
+               Format(", boundary recall %.4g, boundary max %.4g (x1e3)", m.features.boundary_recall,
                    m.features.boundary_max_x1e3));
-  monitor.Info(Fmt("CD %.6g (x1e3)  HD %.6g (x1e3)  ECD %.6g (x1e2)", m.cd_x1e3, m.hd_x1e3, m.ecd_x1e2) +
-               Fmt("  TQ %.4g  TD %.0f  NM-CD %.6g (x1e3)", m.mesh.tq, static_cast<double>(m.td), m.nmcd_x1e3));
+  monitor.Info(Format("CD %.6g (x1e3)  HD %.6g (x1e3)  ECD %.6g (x1e2)", m.cd_x1e3, m.hd_x1e3, m.ecd_x1e2) +
+               Format("  TQ %.4g  TD %.0f  NM-CD %.6g (x1e3)", m.mesh.tq, static_cast<double>(m.td), m.nmcd_x1e3));
   return m;
 }
 

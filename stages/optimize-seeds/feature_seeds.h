@@ -2,7 +2,7 @@
 // The optimizer's per-seed state and the operations on feature seeds that step 7 (feature-seed thinning)
 // and step 8 (feature chains) of docs/optimize-seeds.md make: which seeds crowd a feature seed, the links
 // of the feature curves, where a chain's trial seeds start and whether one stays, and dropping seeds from
-// the state. Used by optimize_seeds.cpp; tests reach SeedsBesideFeatures through optimize_seeds.h.
+// the state. Used by optimizer.cpp and optimize_seeds.cpp; tests reach SeedsBesideFeatures through optimize_seeds.h.
 
 #include <cstddef>
 #include <utility>
