@@ -205,4 +205,46 @@ TriangleMesh CanonicalOrder(const TriangleMesh& mesh) {
   return out;
 }
 
+namespace {
+
+Vec3 FaceNormal(const TriangleMesh& m, const Tri& t) {
+  const Vec3 c = (m.vertices[static_cast<size_t>(t[1])] - m.vertices[static_cast<size_t>(t[0])])
+                     .cross(m.vertices[static_cast<size_t>(t[2])] - m.vertices[static_cast<size_t>(t[0])]);
+  const double len = c.norm();
+  return len > 0 ? Vec3(c / len) : Vec3::Zero();
+}
+
+// Whether face t runs along the directed edge a -> b.
+bool Runs(const Tri& t, int a, int b) {
+  for (int k = 0; k < 3; ++k)
+    if (t[static_cast<size_t>(k)] == a && t[static_cast<size_t>((k + 1) % 3)] == b) return true;
+  return false;
+}
+
+}  // namespace
+
+std::vector<Edge> FeatureEdges(const TriangleMesh& mesh, double min_angle_deg) {
+  const EdgeFaces ef = BuildEdgeFaces(mesh.faces);
+  const double max_cos = std::cos(min_angle_deg * M_PI / 180.0);
+  std::vector<Edge> out;
+  for (size_t e = 0; e < ef.edges.size(); ++e) {
+    const auto& fs = ef.faces[e];
+    if (fs.size() >= 3) {
+      out.push_back(ef.edges[e]);
+      continue;
+    }
+    if (fs.size() != 2) continue;
+    const Tri& f0 = mesh.faces[static_cast<size_t>(fs[0])];
+    const Tri& f1 = mesh.faces[static_cast<size_t>(fs[1])];
+    const Vec3 n0 = FaceNormal(mesh, f0);
+    Vec3 n1 = FaceNormal(mesh, f1);
+    if (n0.isZero() || n1.isZero()) continue;
+    const int a = ef.edges[e][0], b = ef.edges[e][1];
+    // Consistently oriented faces run along the edge in opposite directions; otherwise turn one round.
+    if (Runs(f0, a, b) == Runs(f1, a, b)) n1 = -n1;
+    if (n0.dot(n1) < max_cos) out.push_back(ef.edges[e]);
+  }
+  return out;
+}
+
 }  // namespace voroudf

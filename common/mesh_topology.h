@@ -69,6 +69,12 @@ TopologyStats ComputeTopology(const TriangleMesh& mesh);
 /// Component id per face, faces connected when they share an edge; ids in order of first face.
 std::vector<int> EdgeConnectedComponents(const std::vector<Tri>& faces, int* num_components);
 
+/// Feature edges of a welded mesh: edges with two faces whose dihedral angle departs from flat by more
+/// than `min_angle_deg` (the angle between the faces' normals, with the normals oriented consistently
+/// across the edge when the faces are), and every non-manifold edge (3+ faces: a branching curve).
+/// In BuildEdgeFaces order.
+std::vector<Edge> FeatureEdges(const TriangleMesh& mesh, double min_angle_deg);
+
 /// Merges vertices closer than `tolerance` (grid hashing; the smallest index is kept), remaps faces,
 /// drops faces that became degenerate and vertices no face references.
 TriangleMesh WeldVertices(const TriangleMesh& mesh, double tolerance);

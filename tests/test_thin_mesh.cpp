@@ -3,6 +3,9 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
+#include <map>
+#include <random>
 #include <set>
 
 #include "common/errors.h"
@@ -11,6 +14,7 @@
 #include "common/shapes.h"
 #include "formats/mesh_io.h"
 #include "formats/seeds_io.h"
+#include "stages/thin-mesh/relax.h"
 #include "stages/thin-mesh/rim_flaps.h"
 #include "stages/thin-mesh/thin_mesh.h"
 #include "tests/support/test_support.h"
@@ -549,6 +553,139 @@ TEST(ThinMesh, BadOptionsAreUsageErrors) {
     l.layer_angle_deg = angle;
     EXPECT_THROW(l.Check(), UsageError) << angle;
   }
+}
+
+// ---- step 7: tangential relaxation ----
+
+// The surface of the cube [-0.5,0.5]^3, each side an n x n grid of two triangles per cell, welded, facing
+// out; the vertices inside a side moved in its plane by up to `jitter` cells (fixed stream).
+TriangleMesh CubeGrid(int n, double jitter) {
+  TriangleMesh c;
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(-jitter / n, jitter / n);
+  for (int axis = 0; axis < 3; ++axis)
+    for (int side = 0; side < 2; ++side) {
+      const int base = static_cast<int>(c.vertices.size());
+      for (int j = 0; j <= n; ++j)
+        for (int i = 0; i <= n; ++i) {
+          const bool inside = i > 0 && i < n && j > 0 && j < n;
+          Vec3 q;
+          q[axis] = side - 0.5;
+          q[(axis + 1) % 3] = double(i) / n - 0.5 + (inside ? u(rng) : 0.0);
+          q[(axis + 2) % 3] = double(j) / n - 0.5 + (inside ? u(rng) : 0.0);
+          c.vertices.push_back(q);
+        }
+      for (int j = 0; j < n; ++j)
+        for (int i = 0; i < n; ++i) {
+          const int a = base + j * (n + 1) + i, b = a + 1, d = a + n + 1, e = d + 1;
+          if (side == 1) {
+            c.faces.push_back({a, b, e});
+            c.faces.push_back({a, e, d});
+          } else {
+            c.faces.push_back({a, e, b});
+            c.faces.push_back({a, d, e});
+          }
+        }
+    }
+  return WeldVertices(c, 1e-9);
+}
+
+double MeanQuality(const TriangleMesh& m) {
+  double sum = 0;
+  for (const Tri& t : m.faces)
+    sum += TriangleQuality(m.vertices[static_cast<size_t>(t[0])], m.vertices[static_cast<size_t>(t[1])],
+                           m.vertices[static_cast<size_t>(t[2])]);
+  return sum / static_cast<double>(m.faces.size());
+}
+
+TEST(Relax, ASpheresTrianglesEvenOutOnTheSphereWithTheSameFaces) {
+  const auto udf = MakeShape("sphere");
+  TriangleMesh mesh = CubeGrid(8, 0.3);
+  for (Vec3& p : mesh.vertices) p = 0.5 * p.normalized();
+  const TriangleMesh before = mesh;
+  const RelaxStats st = RelaxTangentially(*udf, mesh, RelaxOptions{}, Monitor::Null());
+  // All but a few at the grid's 8 corners, where three sides meet and a jittered edge can exceed 30 degrees.
+  EXPECT_GE(st.movable, mesh.vertices.size() - 8 * 4);
+  EXPECT_EQ(mesh.faces, before.faces);
+  const double tolerance = 1e-5 * udf->Domain().Diagonal();  // the projection's, as for the seeds
+  for (const Vec3& p : mesh.vertices) EXPECT_NEAR(p.norm(), 0.5, tolerance);
+  EXPECT_GT(MeanQuality(mesh), MeanQuality(before) + 0.03);
+  RelaxOptions off;
+  off.iterations = 0;
+  TriangleMesh same = before;
+  RelaxTangentially(*udf, same, off, Monitor::Null());
+  EXPECT_EQ(same.vertices, before.vertices);
+}
+
+TEST(Relax, ACubesEdgesAndCornersStayAndEveryOtherVertexStaysOnItsSide) {
+  const auto udf = MakeShape("cube");
+  TriangleMesh mesh = CubeGrid(6, 0.3);
+  const TriangleMesh before = mesh;
+  const RelaxStats st = RelaxTangentially(*udf, mesh, RelaxOptions{}, Monitor::Null());
+  EXPECT_EQ(st.movable, 6u * 5 * 5) << "the vertices inside the sides";
+  EXPECT_GT(st.moves, 0u);
+  for (size_t v = 0; v < mesh.vertices.size(); ++v) {
+    const Vec3 &p = mesh.vertices[v], &q = before.vertices[v];
+    int on_side = 0;
+    for (int k = 0; k < 3; ++k) on_side += std::abs(std::abs(q[k]) - 0.5) < 1e-12 ? 1 : 0;
+    if (on_side >= 2) {
+      EXPECT_EQ(p, q) << "a vertex on an edge of the cube moved";
+      continue;
+    }
+    for (int k = 0; k < 3; ++k) {
+      if (std::abs(std::abs(q[k]) - 0.5) < 1e-12) EXPECT_NEAR(p[k], q[k], 1e-5 * udf->Domain().Diagonal()) << "left its side";
+      else EXPECT_LT(std::abs(p[k]), 0.5) << "crossed an edge of the cube";
+    }
+  }
+  EXPECT_GT(MeanQuality(mesh), MeanQuality(before) + 0.02);
+}
+
+TEST(Relax, RimAndBranchingVerticesStayTheSheetInsideMovesInItsPlane) {
+  // A 6 x 6 grid on the disc's plane, its inside jittered, with a fin of one row of cells standing on its
+  // middle line (the fin is not in the field: all its vertices lie on the rim or on the branching line).
+  const auto udf = MakeShape("disc");
+  const int n = 6;
+  TriangleMesh sheet;
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(-0.3 * 0.6 / n, 0.3 * 0.6 / n);
+  for (int j = 0; j <= n; ++j)
+    for (int i = 0; i <= n; ++i) {
+      const bool inside = i > 0 && i < n && j > 0 && j < n;
+      const double x = 0.6 * i / n - 0.3 + (inside ? u(rng) : 0.0);
+      const double y = 0.6 * j / n - 0.3 + (inside && j != n / 2 ? u(rng) : 0.0);  // the middle row on y = 0
+      sheet.vertices.emplace_back(x, y, 0.0);
+    }
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) {
+      const int a = j * (n + 1) + i, b = a + 1, d = a + n + 1, e = d + 1;
+      sheet.faces.push_back({a, b, e});
+      sheet.faces.push_back({a, e, d});
+    }
+  std::vector<int> spine;  // the grid's vertices on y = 0, by x
+  for (size_t v = 0; v < sheet.vertices.size(); ++v)
+    if (std::abs(sheet.vertices[v].y()) < 1e-12) spine.push_back(static_cast<int>(v));
+  std::sort(spine.begin(), spine.end(), [&](int a, int b) { return sheet.vertices[static_cast<size_t>(a)].x() < sheet.vertices[static_cast<size_t>(b)].x(); });
+  for (size_t k = 0; k + 1 < spine.size(); ++k) {
+    const int top0 = static_cast<int>(sheet.vertices.size());
+    sheet.vertices.push_back(sheet.vertices[static_cast<size_t>(spine[k])] + Vec3(0, 0, 0.1));
+    sheet.vertices.push_back(sheet.vertices[static_cast<size_t>(spine[k + 1])] + Vec3(0, 0, 0.1));
+    sheet.faces.push_back({spine[k], spine[k + 1], top0 + 1});
+    sheet.faces.push_back({spine[k], top0 + 1, top0});
+  }
+  sheet = WeldVertices(sheet, 1e-9);
+  const TriangleMesh before = sheet;
+  const RelaxStats st = RelaxTangentially(*udf, sheet, RelaxOptions{}, Monitor::Null());
+  EXPECT_EQ(st.movable, 5u * 4) << "inside the grid, off the branching line";
+  EXPECT_GT(st.moves, 0u);
+  const TopologyStats t = ComputeTopology(sheet);
+  for (size_t v = 0; v < sheet.vertices.size(); ++v) {
+    const Vec3 &p = sheet.vertices[v], &q = before.vertices[v];
+    const bool rim_or_fin = std::abs(std::abs(q.x()) - 0.3) < 1e-12 || std::abs(std::abs(q.y()) - 0.3) < 1e-12 ||
+                            std::abs(q.y()) < 1e-12 || q.z() != 0.0;
+    if (rim_or_fin) EXPECT_EQ(p, q) << "a rim, branching or fin vertex moved";
+    else EXPECT_NEAR(p.z(), 0.0, 1e-5 * udf->Domain().Diagonal());
+  }
+  EXPECT_EQ(ComputeTopology(before).nonmanifold_edges, t.nonmanifold_edges);
 }
 
 class ThinMeshExe : public ::testing::Test {

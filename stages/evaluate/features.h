@@ -10,12 +10,6 @@
 
 namespace voroudf {
 
-/// Feature edges of a welded mesh: edges with two faces whose dihedral angle departs from flat by more
-/// than `min_angle_deg` (the angle between the faces' normals, with the normals oriented consistently
-/// across the edge when the faces are), and every non-manifold edge (3+ faces: a branching curve).
-/// In BuildEdgeFaces order.
-std::vector<Edge> FeatureEdges(const TriangleMesh& mesh, double min_angle_deg);
-
 /// The median length of the mesh's edges (each edge once); 0 without edges.
 double MedianEdgeLength(const TriangleMesh& mesh);
 

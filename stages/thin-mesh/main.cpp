@@ -40,6 +40,13 @@ int main(int argc, char** argv) {
   app.add_option("--shell-rings", options.shell_rings,
                  "open the closed shells the paper's steps leave (bubbles no face pair can thin) that lie within "
                  "this many edges of one of their faces, at a face off the surface (0: off; not with --thinning paper)");
+  app.add_option("--relax-iters", options.relax.iterations,
+                 "then even the triangles out: steps moving each vertex inside a smooth patch toward its "
+                 "neighbours' centroid along the surface (0: off, the paper's mesh: vertices are the seeds)");
+  app.add_option("--relax-step", options.relax.step, "share of the way to the centroid taken per step");
+  app.add_option("--relax-feature-angle", options.relax.feature_angle_deg,
+                 "vertices on an edge whose faces' normals differ by more than this (deg) stay, as on rims "
+                 "and non-manifold edges");
 
   return cli.Run(argc, argv, [&] { options.Check(); }, [&](voroudf::Monitor& monitor) {
     const auto udf = cli.OpenUdf(monitor);

@@ -351,6 +351,7 @@ void ThinMeshOptions::Check() const {
   if (shell_rings < 0 || shell_rings > 4) throw UsageError("--shell-rings must be in [0, 4]");
   if (!(degenerate_quality >= 0.0 && degenerate_quality < 0.5))
     throw UsageError("--degenerate-quality must be in [0, 0.5)");
+  relax.Check();
 }
 
 namespace {
@@ -530,6 +531,8 @@ TriangleMesh ThinMesh(const Udf& udf, const TriangleMesh& thick, const ThinMeshO
   out.vertices = thick.vertices;
   out.faces = oriented.faces();
   out = RemoveUnreferencedVertices(out);
+  // 7. Tangential relaxation: even triangles, the same connectivity, every vertex on the zero set.
+  st.relax = RelaxTangentially(udf, out, options.relax, monitor);
   monitor.Info(Count(out.vertices.size(), "vertices, ") + Count(out.faces.size(), "faces out"));
   if (stats_out) *stats_out = st;
   return out;

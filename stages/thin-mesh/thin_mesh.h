@@ -9,6 +9,7 @@
 #include "common/types.h"
 #include "common/udf.h"
 #include "formats/mesh_io.h"
+#include "stages/thin-mesh/relax.h"
 
 namespace voroudf {
 
@@ -38,6 +39,8 @@ struct ThinMeshOptions {
   /// --shell-rings (not with --thinning paper; 0: off): step 3b opens the closed shells that steps 1-3 leave
   /// and whose faces lie within this many edges of one of their faces, at a face off the surface.
   int shell_rings = 1;
+  /// Step 7, tangential relaxation (relax.h; --relax-iters, --relax-step, --relax-feature-angle).
+  RelaxOptions relax;
 
   /// Throws UsageError for values that cannot work.
   void Check() const;
@@ -62,6 +65,7 @@ struct ThinMeshStats {
   size_t holes_closed_after_folds = 0;  ///< step 5b: triangular holes closed after them
   size_t rim_flaps_removed = 0;     ///< step 6: flaps at a rim removed
   int rounds = 0;                   ///< rounds of (tetrahedra, components) until nothing changed
+  RelaxStats relax;                 ///< step 7
 };
 
 /// Thins a dual mesh (paper Sec. 3.4). Written by hand: no installed library handles triangle sets with
@@ -96,6 +100,8 @@ struct ThinMeshStats {
 ///     edge. Where a branching curve ends at the rims of its sheets, the regions of a rim seed of one sheet
 ///     and a seed of another meet at the curve's end, and the dual joins them by a face across the curve.
 ///  Manifold components are then oriented consistently, unreferenced vertices dropped (order kept).
+///  7. RelaxTangentially (relax.h), unless options.relax.iterations is 0: the vertices inside smooth manifold
+///     patches are evened out along the surface; the connectivity stays.
 ///
 /// \param udf    the field, for the centroid values
 /// \param thick  vertices + faces with valid indices (the caller validates them)
