@@ -1,6 +1,7 @@
 // thin-mesh: the thinning rules on hand-made meshes (paper Sec. 3.4, Fig. 8) and the executable's handling of
 // bad input. The field is shape:disc, whose UDF is |z| near the origin, so a face's centroid UDF is its height.
 #include <gtest/gtest.h>
+#include <omp.h>
 
 #include <algorithm>
 #include <cmath>
@@ -610,6 +611,14 @@ TEST(Relax, ASpheresTrianglesEvenOutOnTheSphereWithTheSameFaces) {
   const double tolerance = 1e-5 * udf->Domain().Diagonal();  // the projection's, as for the seeds
   for (const Vec3& p : mesh.vertices) EXPECT_NEAR(p.norm(), 0.5, tolerance);
   EXPECT_GT(MeanQuality(mesh), MeanQuality(before) + 0.03);
+  // The same positions whatever the threads (every step from the previous one's positions).
+  for (int threads : {1, 2}) {
+    omp_set_num_threads(threads);
+    TriangleMesh again = before;
+    RelaxTangentially(*udf, again, RelaxOptions{}, Monitor::Null());
+    EXPECT_EQ(again.vertices, mesh.vertices) << threads << " threads";
+  }
+  omp_set_num_threads(omp_get_num_procs());
   RelaxOptions off;
   off.iterations = 0;
   TriangleMesh same = before;
