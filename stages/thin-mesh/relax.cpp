@@ -78,6 +78,34 @@ Rings MovableVertices(const TriangleMesh& mesh, double feature_angle_deg) {
   return r;
 }
 
+// Undoes the accepted moves of every face's vertices that the moves (all at once) would turn by more than
+// acos(min_cos), until no face turns that far. accept[i] is movers[i]'s.
+void UndoTurnedFaces(const TriangleMesh& mesh, const std::vector<int>& movers, const std::vector<Vec3>& moved,
+                     double min_cos, std::vector<char>* accept) {
+  std::vector<int> slot(mesh.vertices.size(), -1);
+  for (size_t i = 0; i < movers.size(); ++i) slot[static_cast<size_t>(movers[i])] = static_cast<int>(i);
+  auto moving = [&](int v) {
+    const int k = slot[static_cast<size_t>(v)];
+    return k >= 0 && (*accept)[static_cast<size_t>(k)];
+  };
+  for (bool again = true; again;) {
+    again = false;
+    std::vector<Vec3> trial = mesh.vertices;
+    for (size_t i = 0; i < movers.size(); ++i)
+      if ((*accept)[i]) trial[static_cast<size_t>(movers[i])] = moved[i];
+    for (const Tri& t : mesh.faces) {
+      if (!moving(t[0]) && !moving(t[1]) && !moving(t[2])) continue;
+      const Vec3 before = AreaNormal(mesh.vertices, t), after = AreaNormal(trial, t);
+      if (after.norm() > 0 && after.dot(before) >= min_cos * after.norm() * before.norm()) continue;
+      for (int v : t)
+        if (moving(v)) {
+          (*accept)[static_cast<size_t>(slot[static_cast<size_t>(v)])] = 0;
+          again = true;
+        }
+    }
+  }
+}
+
 }  // namespace
 
 RelaxStats RelaxTangentially(const Udf& udf, TriangleMesh& mesh, const RelaxOptions& options, Monitor& monitor) {
@@ -113,27 +141,7 @@ RelaxStats RelaxTangentially(const Udf& udf, TriangleMesh& mesh, const RelaxOpti
       const Vec3& from = x[static_cast<size_t>(movers[i])];
       accept[i] = r.converged[i] && (moved[i] - target[i]).norm() <= (target[i] - from).norm();
     }
-    // Faces turned too far: undo their moved vertices, until none is.
-    std::vector<int> slot(x.size(), -1);
-    for (size_t i = 0; i < movers.size(); ++i) slot[static_cast<size_t>(movers[i])] = static_cast<int>(i);
-    for (bool again = true; again;) {
-      again = false;
-      std::vector<Vec3> trial = x;
-      for (size_t i = 0; i < movers.size(); ++i)
-        if (accept[i]) trial[static_cast<size_t>(movers[i])] = moved[i];
-      for (const Tri& t : mesh.faces) {
-        bool touched = false;
-        for (int v : t) touched = touched || (slot[static_cast<size_t>(v)] >= 0 && accept[static_cast<size_t>(slot[static_cast<size_t>(v)])]);
-        if (!touched) continue;
-        const Vec3 before = AreaNormal(x, t), after = AreaNormal(trial, t);
-        if (after.dot(before) >= min_cos * after.norm() * before.norm() && after.norm() > 0) continue;
-        for (int v : t)
-          if (slot[static_cast<size_t>(v)] >= 0 && accept[static_cast<size_t>(slot[static_cast<size_t>(v)])]) {
-            accept[static_cast<size_t>(slot[static_cast<size_t>(v)])] = 0;
-            again = true;
-          }
-      }
-    }
+    UndoTurnedFaces(mesh, movers, moved, min_cos, &accept);
     for (size_t i = 0; i < movers.size(); ++i) {
       if (accept[i]) {
         x[static_cast<size_t>(movers[i])] = moved[i];
