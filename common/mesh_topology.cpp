@@ -180,6 +180,21 @@ double TriangleQuality(const Vec3& a, const Vec3& b, const Vec3& c) {
   return 6.0 / std::sqrt(3.0) * area / (half_perimeter * longest);
 }
 
+double MeanTriangleQuality(const TriangleMesh& mesh) {
+  const size_t nf = mesh.faces.size();
+  if (nf == 0) return 0.0;
+  std::vector<double> q(nf);
+#pragma omp parallel for schedule(static)
+  for (long long f = 0; f < static_cast<long long>(nf); ++f) {
+    const Tri& t = mesh.faces[static_cast<size_t>(f)];
+    q[static_cast<size_t>(f)] = TriangleQuality(mesh.vertices[static_cast<size_t>(t[0])], mesh.vertices[static_cast<size_t>(t[1])],
+                                                mesh.vertices[static_cast<size_t>(t[2])]);
+  }
+  double sum = 0;
+  for (double x : q) sum += x;  // in face order, whatever the threads
+  return sum / static_cast<double>(nf);
+}
+
 TriangleMesh CanonicalOrder(const TriangleMesh& mesh) {
   std::vector<int> order(mesh.vertices.size());
   for (size_t i = 0; i < order.size(); ++i) order[i] = static_cast<int>(i);
@@ -205,11 +220,16 @@ TriangleMesh CanonicalOrder(const TriangleMesh& mesh) {
   return out;
 }
 
+Vec3 AreaNormal(const std::vector<Vec3>& vertices, const Tri& t) {
+  return (vertices[static_cast<size_t>(t[1])] - vertices[static_cast<size_t>(t[0])])
+      .cross(vertices[static_cast<size_t>(t[2])] - vertices[static_cast<size_t>(t[0])]);
+}
+
 namespace {
 
-Vec3 FaceNormal(const TriangleMesh& m, const Tri& t) {
-  const Vec3 c = (m.vertices[static_cast<size_t>(t[1])] - m.vertices[static_cast<size_t>(t[0])])
-                     .cross(m.vertices[static_cast<size_t>(t[2])] - m.vertices[static_cast<size_t>(t[0])]);
+// The face's unit normal, or zero for a face of no area.
+Vec3 UnitNormal(const std::vector<Vec3>& vertices, const Tri& t) {
+  const Vec3 c = AreaNormal(vertices, t);
   const double len = c.norm();
   return len > 0 ? Vec3(c / len) : Vec3::Zero();
 }
@@ -224,7 +244,10 @@ bool Runs(const Tri& t, int a, int b) {
 }  // namespace
 
 std::vector<Edge> FeatureEdges(const TriangleMesh& mesh, double min_angle_deg) {
-  const EdgeFaces ef = BuildEdgeFaces(mesh.faces);
+  return FeatureEdges(mesh, BuildEdgeFaces(mesh.faces), min_angle_deg);
+}
+
+std::vector<Edge> FeatureEdges(const TriangleMesh& mesh, const EdgeFaces& ef, double min_angle_deg) {
   const double max_cos = std::cos(min_angle_deg * M_PI / 180.0);
   std::vector<Edge> out;
   for (size_t e = 0; e < ef.edges.size(); ++e) {
@@ -236,8 +259,8 @@ std::vector<Edge> FeatureEdges(const TriangleMesh& mesh, double min_angle_deg) {
     if (fs.size() != 2) continue;
     const Tri& f0 = mesh.faces[static_cast<size_t>(fs[0])];
     const Tri& f1 = mesh.faces[static_cast<size_t>(fs[1])];
-    const Vec3 n0 = FaceNormal(mesh, f0);
-    Vec3 n1 = FaceNormal(mesh, f1);
+    const Vec3 n0 = UnitNormal(mesh.vertices, f0);
+    Vec3 n1 = UnitNormal(mesh.vertices, f1);
     if (n0.isZero() || n1.isZero()) continue;
     const int a = ef.edges[e][0], b = ef.edges[e][1];
     // Consistently oriented faces run along the edge in opposite directions; otherwise turn one round.

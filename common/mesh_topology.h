@@ -72,8 +72,12 @@ std::vector<int> EdgeConnectedComponents(const std::vector<Tri>& faces, int* num
 /// Feature edges of a welded mesh: edges with two faces whose dihedral angle departs from flat by more
 /// than `min_angle_deg` (the angle between the faces' normals, with the normals oriented consistently
 /// across the edge when the faces are), and every non-manifold edge (3+ faces: a branching curve).
-/// In BuildEdgeFaces order.
+/// In BuildEdgeFaces order. The second form takes the mesh's incidence, when the caller has it.
 std::vector<Edge> FeatureEdges(const TriangleMesh& mesh, double min_angle_deg);
+std::vector<Edge> FeatureEdges(const TriangleMesh& mesh, const EdgeFaces& ef, double min_angle_deg);
+
+/// (b − a) × (c − a) for face t = (a, b, c) of `vertices`: its normal by its orientation, twice its area long.
+Vec3 AreaNormal(const std::vector<Vec3>& vertices, const Tri& t);
 
 /// Merges vertices closer than `tolerance` (grid hashing; the smallest index is kept), remaps faces,
 /// drops faces that became degenerate and vertices no face references.
@@ -91,5 +95,9 @@ TriangleMesh RemoveUnreferencedVertices(const TriangleMesh& mesh);
 /// Triangle quality of Frey & Borouchaki (paper, supplementary): (6/sqrt 3) * area / (half-perimeter *
 /// longest edge); 1 for an equilateral triangle, 0 for a degenerate one.
 double TriangleQuality(const Vec3& a, const Vec3& b, const Vec3& c);
+
+/// Mean over all faces of TriangleQuality (the paper's TQ): 1 for an equilateral triangle, 0 for a
+/// degenerate one (which still counts in the mean). 0 for a mesh without faces.
+double MeanTriangleQuality(const TriangleMesh& mesh);
 
 }  // namespace voroudf

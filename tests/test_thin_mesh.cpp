@@ -591,14 +591,6 @@ TriangleMesh CubeGrid(int n, double jitter) {
   return WeldVertices(c, 1e-9);
 }
 
-double MeanQuality(const TriangleMesh& m) {
-  double sum = 0;
-  for (const Tri& t : m.faces)
-    sum += TriangleQuality(m.vertices[static_cast<size_t>(t[0])], m.vertices[static_cast<size_t>(t[1])],
-                           m.vertices[static_cast<size_t>(t[2])]);
-  return sum / static_cast<double>(m.faces.size());
-}
-
 TEST(Relax, ASpheresTrianglesEvenOutOnTheSphereWithTheSameFaces) {
   const auto udf = MakeShape("sphere");
   TriangleMesh mesh = CubeGrid(8, 0.3);
@@ -610,7 +602,7 @@ TEST(Relax, ASpheresTrianglesEvenOutOnTheSphereWithTheSameFaces) {
   EXPECT_EQ(mesh.faces, before.faces);
   const double tolerance = 1e-5 * udf->Domain().Diagonal();  // the projection's, as for the seeds
   for (const Vec3& p : mesh.vertices) EXPECT_NEAR(p.norm(), 0.5, tolerance);
-  EXPECT_GT(MeanQuality(mesh), MeanQuality(before) + 0.03);
+  EXPECT_GT(MeanTriangleQuality(mesh), MeanTriangleQuality(before) + 0.03);
   // The same positions whatever the threads (every step from the previous one's positions).
   for (int threads : {1, 2}) {
     omp_set_num_threads(threads);
@@ -646,7 +638,7 @@ TEST(Relax, ACubesEdgesAndCornersStayAndEveryOtherVertexStaysOnItsSide) {
       else EXPECT_LT(std::abs(p[k]), 0.5) << "crossed an edge of the cube";
     }
   }
-  EXPECT_GT(MeanQuality(mesh), MeanQuality(before) + 0.02);
+  EXPECT_GT(MeanTriangleQuality(mesh), MeanTriangleQuality(before) + 0.02);
 }
 
 TEST(Relax, RimAndBranchingVerticesStayTheSheetInsideMovesInItsPlane) {

@@ -361,20 +361,6 @@ std::vector<Vec3> SampleNonManifoldEdges(const TriangleMesh& mesh, size_t count,
   return SampleEdges(mesh, NonManifoldEdges(mesh), count, total_length);
 }
 
-double MeanTriangleQuality(const TriangleMesh& mesh) {
-  const size_t nf = mesh.faces.size();
-  if (nf == 0) return 0.0;
-  std::vector<double> q(nf);
-#pragma omp parallel for schedule(static)
-  for (long long f = 0; f < static_cast<long long>(nf); ++f) {
-    const Tri& t = mesh.faces[f];
-    q[f] = TriangleQuality(mesh.vertices[t[0]], mesh.vertices[t[1]], mesh.vertices[t[2]]);
-  }
-  double sum = 0;
-  for (double x : q) sum += x;
-  return sum / static_cast<double>(nf);
-}
-
 TopologyStats WeldedTopology(const TriangleMesh& mesh, double tolerance) {
   return ComputeTopology(WeldVertices(mesh, tolerance));
 }

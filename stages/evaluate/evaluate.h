@@ -126,10 +126,6 @@ std::vector<Vec3> SampleEdges(const TriangleMesh& mesh, const std::vector<Edge>&
 /// SampleEdges over NonManifoldEdges(mesh).
 std::vector<Vec3> SampleNonManifoldEdges(const TriangleMesh& mesh, size_t count, double* total_length);
 
-/// Mean over all faces of TriangleQuality (Frey & Borouchaki): 1 for an equilateral triangle, 0 for a
-/// degenerate one (which still counts in the mean). 0 for a mesh without faces.
-double MeanTriangleQuality(const TriangleMesh& mesh);
-
 /// Topology after WeldVertices(mesh, tolerance): vertices closer than `tolerance` merged, faces that
 /// collapsed dropped, unreferenced vertices dropped. Its `euler` is the chi of TD.
 TopologyStats WeldedTopology(const TriangleMesh& mesh, double tolerance);

@@ -29,11 +29,6 @@ ProjectionOptions SeedProjection(const Udf& udf) {
   return p;
 }
 
-Vec3 AreaNormal(const std::vector<Vec3>& x, const Tri& t) {
-  return (x[static_cast<size_t>(t[1])] - x[static_cast<size_t>(t[0])])
-      .cross(x[static_cast<size_t>(t[2])] - x[static_cast<size_t>(t[0])]);
-}
-
 // Per vertex, its neighbours and faces (CSR-free: a few thousand vertices), and whether it may move.
 struct Rings {
   std::vector<std::vector<int>> neighbours, faces;
@@ -55,7 +50,7 @@ Rings MovableVertices(const TriangleMesh& mesh, double feature_angle_deg) {
     r.neighbours[static_cast<size_t>(b)].push_back(a);
     if (ef.faces[e].size() != 2) r.movable[static_cast<size_t>(a)] = r.movable[static_cast<size_t>(b)] = 0;
   }
-  for (const Edge& e : FeatureEdges(mesh, feature_angle_deg))
+  for (const Edge& e : FeatureEdges(mesh, ef, feature_angle_deg))
     r.movable[static_cast<size_t>(e[0])] = r.movable[static_cast<size_t>(e[1])] = 0;
   // One fan: the vertex's faces connected through its edges (two cones touching at a vertex are two).
   for (size_t v = 0; v < n; ++v) {
