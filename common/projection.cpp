@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 
 #include "common/errors.h"
@@ -60,45 +61,53 @@ void MergeTwinSheets(const Udf& udf, std::vector<Vec3>& points, ProjectionResult
   std::vector<Vec3> g;
   udf.Evaluate(probes, d, g);
   // A probe counts when it read less than within cos 30° with its gradient within 45° of its own direction.
+  // Every such probe is a candidate, not just the nearest: where the error varies along the normal the field
+  // rises slower than 1 on one side, and a probe there passes the test although no twin lies beyond it; its
+  // projection comes back to the point itself. So each candidate's twin is found and checked, and the nearest
+  // one that checks out wins.
   const double passed = std::cos(M_PI / 6.0), onward = std::cos(M_PI / 4.0);
-  std::vector<size_t> moved;
-  std::vector<Vec3> target;
-  std::vector<double> half;
-  for (size_t k = 0; k < probed.size(); ++k) {
-    double best_t = 0.0;
-    Vec3 best_probe = Vec3::Zero();
-    for (size_t scale = 0; scale < kScales.size() && best_t == 0.0; ++scale)
+  std::vector<size_t> owner;  // per candidate: index into probed
+  std::vector<Vec3> twin_at;  // per candidate: its probe, then the twin it projects to
+  for (size_t k = 0; k < probed.size(); ++k)
+    for (size_t scale = 0; scale < kScales.size(); ++scale)
       for (int side = 0; side < 2; ++side) {
         const size_t j = (kScales.size() * k + scale) * 2 + static_cast<size_t>(side);
         const double r = kScales[scale] * within;
         const Vec3 v = side == 0 ? dir[k] : Vec3(-dir[k]);
         if (!std::isfinite(d[j]) || !(d[j] < passed * r) || g[j].dot(v) < onward * g[j].norm()) continue;
-        const double t = r - d[j];
-        if (best_t == 0.0 || t < best_t) best_t = t, best_probe = probes[j];
+        owner.push_back(k);
+        twin_at.push_back(probes[j]);
       }
-    if (best_t == 0.0) continue;
-    moved.push_back(probed[k]);
-    target.push_back(best_probe);
-  }
-  if (moved.empty()) return;
+  if (owner.empty()) return;
   // The twin itself, from that probe: where its own error puts it, not where the probe's error said.
   ProjectionOptions to_twin;
   to_twin.tolerance = tolerance;
   to_twin.max_iterations = 8;
-  const ProjectionResult twin = ProjectToZeroSet(udf, target, to_twin, Monitor::Null());
-  for (size_t k = 0; k < moved.size(); ++k) {
-    const double t = (target[k] - points[moved[k]]).norm();
-    half.push_back(0.5 * t);
-    target[k] = 0.5 * (target[k] + points[moved[k]]);
-    if (!twin.converged[k] || !(t < within)) half.back() = -1.0;
+  const ProjectionResult twin = ProjectToZeroSet(udf, twin_at, to_twin, Monitor::Null());
+  std::vector<double> separation(owner.size(), -1.0);  // -1: no twin
+  std::vector<Vec3> midpoint(owner.size());
+  for (size_t c = 0; c < owner.size(); ++c) {
+    const Vec3& p = points[probed[owner[c]]];
+    const double t = (twin_at[c] - p).norm();
+    midpoint[c] = 0.5 * (twin_at[c] + p);
+    // Closer than 2 tolerances is the point's own sheet, where the field's zero is only known to a tolerance.
+    if (twin.converged[c] && t < within && t > 2.0 * tolerance) separation[c] = t;
   }
-  udf.Evaluate(target, d, g);
-  for (size_t k = 0; k < moved.size(); ++k) {
-    if (!(std::abs(d[k] - half[k]) <= 0.5 * half[k])) continue;  // not a ridge: |d - t/2| > t/4
-    const size_t i = moved[k];
-    points[i] = target[k];
-    result.distance[i] = d[k];
-    result.gradient[i] = g[k];
+  udf.Evaluate(midpoint, d, g);
+  std::vector<size_t> best(probed.size(), SIZE_MAX);
+  for (size_t c = 0; c < owner.size(); ++c) {
+    const double half = 0.5 * separation[c];
+    if (!(half > 0.0) || !(std::abs(d[c] - half) <= 0.5 * half)) continue;  // not a ridge: |d - t/2| > t/4
+    size_t& b = best[owner[c]];
+    if (b == SIZE_MAX || separation[c] < separation[b]) b = c;
+  }
+  for (size_t k = 0; k < probed.size(); ++k) {
+    const size_t c = best[k];
+    if (c == SIZE_MAX) continue;
+    const size_t i = probed[k];
+    points[i] = midpoint[c];
+    result.distance[i] = d[c];
+    result.gradient[i] = g[c];
     ++result.num_merged;
   }
 }

@@ -84,10 +84,12 @@ double EstimateTwinWithin(const ProjectionResult& result, double tolerance, doub
 /// side, a ridge of height |e| on the surface between them), moves each converged point that lies on a zero
 /// sheet to the ridge: it probes x +- r u at r = within/4, within/2 and within (u: the unit gradient there);
 /// a probe that has passed a twin sheet reads d < r cos 30° with its gradient pointing on along the probe (a
-/// single sheet reads about r, a sheet across the probe gives a gradient across it). From the nearest such
-/// probe the twin itself is found by projection; the point moves to the midpoint when the two are less than
-/// `within` apart and the field there reads half their separation t within a quarter of t (the ridge). Six
-/// evaluations per point probed, and a few more per point moved; `result` gets the new positions' values and gradients and counts them in num_merged. Sheets closer than
+/// single sheet reads about r, a sheet across the probe gives a gradient across it). From every such probe a
+/// twin is found by projection (where the error varies along the normal the field rises slower than 1 on one
+/// side, and a probe there passes although its projection comes back to the point's own sheet); the point moves
+/// to the midpoint of the nearest twin more than 2 tolerances and less than `within` away where the field reads
+/// half their separation t within a quarter of t (the ridge). Six evaluations per point probed, and a few more
+/// per candidate twin; `result` gets the new positions' values and gradients and counts them in num_merged. Sheets closer than
 /// `within` that are really there (a wall thinner than the field's error) become their mid-surface.
 /// The stages' log line for a projection that merged twin sheets: "the field has a floor: ...", naming the
 /// separation (absolute and x `diagonal`) and how many `what` (seeds, samples) moved.

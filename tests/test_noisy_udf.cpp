@@ -246,6 +246,48 @@ TEST(Projection, TwinSheetsOfAFieldWithAFloorGoToTheRidgeBetweenThem) {
   }
 }
 
+// FloorAndTwins with an error that varies along the normal, e = -+a + c z (c = 0.2): below the plane the
+// field rises at 1 - c = 0.8 < cos 30° away from its zero sheet, so a probe there reads like one that has
+// passed a twin although none lies beyond it. The sheets lie at z = a / 1.2 and -a / 0.8, their midpoint
+// at -0.21 a.
+class SlantedTwins final : public Udf {
+ public:
+  explicit SlantedTwins(double a) : a_(a) {}
+  void EvaluateChunk(const Vec3* p, size_t count, double* d, Vec3* g) const override {
+    for (size_t i = 0; i < count; ++i) {
+      const double z = p[i].z(), e = (p[i].x() < 0 ? a_ : -a_) + 0.2 * z;
+      d[i] = std::abs(std::abs(z) + e);
+      g[i] = Vec3(0, 0, (z < 0 ? -1.0 : 1.0) * (std::abs(z) + e < 0 ? -1.0 : 1.0));
+    }
+  }
+  Box Domain() const override { return {Vec3::Constant(-1), Vec3::Constant(1)}; }
+  std::string Describe() const override { return "slanted twins"; }
+
+ private:
+  double a_;
+};
+
+TEST(Projection, TwinSheetsWhoseErrorVariesAlongTheNormalGoToTheRidgeFromBothSides) {
+  const double a = 2e-3;
+  const SlantedTwins udf(a);
+  const std::vector<Vec3> start = SlabPoints(600, 0.05, 7);
+  ProjectionOptions options;
+  options.tolerance = 1e-6;  // Newton converges by 0.2 a step on slopes of 1.2 and 0.8
+  options.floor_tolerance = 1e-2;
+  options.twin_factor = 2.5;
+  std::vector<Vec3> points = start;
+  const ProjectionResult r = ProjectToZeroSet(udf, points, options, Monitor::Null());
+  EXPECT_EQ(r.num_converged, start.size());
+  size_t below = 0;
+  for (size_t i = 0; i < points.size(); ++i) {
+    if (start[i].x() < 0) continue;
+    below += start[i].z() < 0;
+    // Midway between the sheets, not on either (0.83 a above, 1.25 a below).
+    EXPECT_NEAR(points[i].z(), -0.2083 * a, 0.05 * a) << "point " << i << " started at " << start[i].transpose();
+  }
+  EXPECT_GT(below, 100u);
+}
+
 TEST(Projection, AnExactFieldsThinWallIsNotMergedForItHasNoFloor) {
   const double a = 2e-3;
   const FloorAndTwins udf(a, false);  // two real sheets 2a apart, no floor anywhere
