@@ -85,29 +85,43 @@ void MergeTwinSheets(const Udf& udf, std::vector<Vec3>& points, ProjectionResult
   to_twin.max_iterations = 8;
   const ProjectionResult twin = ProjectToZeroSet(udf, twin_at, to_twin, Monitor::Null());
   std::vector<double> separation(owner.size(), -1.0);  // -1: no twin
-  std::vector<Vec3> midpoint(owner.size());
+  std::vector<Vec3> quarters(2 * owner.size());
   for (size_t c = 0; c < owner.size(); ++c) {
     const Vec3& p = points[probed[owner[c]]];
     const double t = (twin_at[c] - p).norm();
-    midpoint[c] = 0.5 * (twin_at[c] + p);
-    // Closer than 2 tolerances is the point's own sheet, where the field's zero is only known to a tolerance.
-    if (twin.converged[c] && t < within && t > 2.0 * tolerance) separation[c] = t;
+    quarters[2 * c] = p + 0.25 * (twin_at[c] - p);
+    quarters[2 * c + 1] = p + 0.75 * (twin_at[c] - p);
+    // Closer than 8 tolerances may be the point's own sheet: a converged point lies within a tolerance over the
+    // field's slope of it, on either side, and the slopes below are not measurable there.
+    if (twin.converged[c] && t < within && t > 8.0 * tolerance) separation[c] = t;
   }
-  udf.Evaluate(midpoint, d, g);
+  // Between the sheets |d + e| = |e| - d rises from each sheet to a kink on the surface (d = 0), at slopes
+  // 1 -+ the error's own slope along the line. The quarter points measure both slopes a_p, a_t; where both are
+  // within [0.5, 1.5] it is a ridge, and its top, where the two lines meet, is at s = a_t t / (a_p + a_t) from
+  // the point: the surface itself for an error linear along the line (the midpoint is off by e's slope x t/2).
+  udf.Evaluate(quarters, d, g);
+  std::vector<Vec3> ridge(owner.size());
   std::vector<size_t> best(probed.size(), SIZE_MAX);
   for (size_t c = 0; c < owner.size(); ++c) {
-    const double half = 0.5 * separation[c];
-    if (!(half > 0.0) || !(std::abs(d[c] - half) <= 0.5 * half)) continue;  // not a ridge: |d - t/2| > t/4
+    const double t = separation[c];
+    if (!(t > 0.0)) continue;
+    const double a_p = d[2 * c] / (0.25 * t), a_t = d[2 * c + 1] / (0.25 * t);
+    if (!(a_p >= 0.5 && a_p <= 1.5 && a_t >= 0.5 && a_t <= 1.5)) continue;  // not a ridge
+    const Vec3& p = points[probed[owner[c]]];
+    ridge[c] = p + (a_t / (a_p + a_t)) * (twin_at[c] - p);
     size_t& b = best[owner[c]];
-    if (b == SIZE_MAX || separation[c] < separation[b]) b = c;
+    if (b == SIZE_MAX || t < separation[b]) b = c;
   }
-  for (size_t k = 0; k < probed.size(); ++k) {
-    const size_t c = best[k];
-    if (c == SIZE_MAX) continue;
-    const size_t i = probed[k];
-    points[i] = midpoint[c];
-    result.distance[i] = d[c];
-    result.gradient[i] = g[c];
+  std::vector<size_t> moved;
+  std::vector<Vec3> target;
+  for (size_t k = 0; k < probed.size(); ++k)
+    if (best[k] != SIZE_MAX) moved.push_back(probed[k]), target.push_back(ridge[best[k]]);
+  if (moved.empty()) return;
+  udf.Evaluate(target, d, g);
+  for (size_t k = 0; k < moved.size(); ++k) {
+    points[moved[k]] = target[k];
+    result.distance[moved[k]] = d[k];
+    result.gradient[moved[k]] = g[k];
     ++result.num_merged;
   }
 }

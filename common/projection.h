@@ -86,11 +86,13 @@ double EstimateTwinWithin(const ProjectionResult& result, double tolerance, doub
 /// a probe that has passed a twin sheet reads d < r cos 30° with its gradient pointing on along the probe (a
 /// single sheet reads about r, a sheet across the probe gives a gradient across it). From every such probe a
 /// twin is found by projection (where the error varies along the normal the field rises slower than 1 on one
-/// side, and a probe there passes although its projection comes back to the point's own sheet); the point moves
-/// to the midpoint of the nearest twin more than 2 tolerances and less than `within` away where the field reads
-/// half their separation t within a quarter of t (the ridge). Six evaluations per point probed, and a few more
-/// per candidate twin; `result` gets the new positions' values and gradients and counts them in num_merged. Sheets closer than
-/// `within` that are really there (a wall thinner than the field's error) become their mid-surface.
+/// side, and a probe there passes although its projection comes back to the point's own sheet). Between a
+/// point and its twin, t apart, the field rises from each sheet to a kink on the surface; the quarter points
+/// measure the two slopes, and where both lie in [0.5, 1.5] (a ridge) the point moves to the ridge's top, where
+/// the two lines meet: the surface itself when the error is linear along the line. The nearest such twin more
+/// than 8 tolerances and less than `within` away wins. Six evaluations per point probed, and a few more per
+/// candidate twin; `result` gets the new positions' values and gradients and counts them in num_merged. Sheets
+/// closer than `within` that are really there (a wall thinner than the field's error) become one surface.
 /// The stages' log line for a projection that merged twin sheets: "the field has a floor: ...", naming the
 /// separation (absolute and x `diagonal`) and how many `what` (seeds, samples) moved.
 std::string TwinSheetsSummary(const ProjectionResult& result, double diagonal, const std::string& what);
