@@ -16,6 +16,7 @@
 #include "common/udf_spec.h"
 #include "formats/mesh_io.h"
 #include "formats/seeds_io.h"
+#include "stages/optimize-seeds/fitted_normals.h"
 #include "stages/optimize-seeds/l1_tangent.h"
 #include "stages/optimize-seeds/optimize_seeds.h"
 #include "stages/optimize-seeds/repulsion.h"
@@ -30,6 +31,75 @@ namespace {
 using test::RunProgram;
 using test::NearestNeighbourCv;
 using test::TempDir;
+
+// ------------------------------------------------------------------------------------ fitted sample planes
+
+// One cell of M samples in a ball of radius r about the origin, on the field d = |z| of the plane z = 0, each
+// gradient turned by `deg` degrees in a random direction (0: exact).
+CellSamples PlaneCell(double deg, size_t m, double r, uint64_t seed) {
+  CellSamples cells;
+  Rng rng(seed, 0);
+  cells.sample_offset = {0, m};
+  for (size_t k = 0; k < m; ++k) {
+    Vec3 p;
+    do p = Vec3(rng.Uniform(-r, r), rng.Uniform(-r, r), rng.Uniform(-r, r)); while (p.norm() > r);
+    const Vec3 n(0, 0, p.z() < 0 ? -1.0 : 1.0);
+    const double phi = rng.Uniform(0, 2 * M_PI), a = deg * M_PI / 180;
+    cells.point.push_back(p);
+    cells.distance.push_back(std::abs(p.z()));
+    cells.gradient.push_back(std::cos(a) * n + std::sin(a) * Vec3(std::cos(phi), std::sin(phi), 0.0));
+  }
+  return cells;
+}
+
+// A turned gradient tilts its sample's plane by the whole angle but moves the foot point off the plane by
+// only d (1 - cos θ): the planes fitted to the foot points are the face's, within a few degrees.
+TEST(FittedSamplePlanes, GradientsTurnedBy15DegreesGiveTheFacesPlaneBack) {
+  CellSamples cells = PlaneCell(15.0, 100, 0.1, 3);
+  const double measured = MeasureGradientError(cells, SamplePlaneFit{});
+  const double fitted = FitSamplePlanes(cells, SamplePlaneFit{});
+  EXPECT_NEAR(measured * 180 / M_PI, 15.0, 2.0);
+  EXPECT_DOUBLE_EQ(fitted, measured);
+  std::vector<double> tilt;
+  for (size_t k = 0; k < cells.point.size(); ++k) {
+    const double side = cells.point[k].z() < 0 ? -1.0 : 1.0;
+    tilt.push_back(std::acos(std::min(1.0, side * cells.gradient[k].z())) * 180 / M_PI);
+    // The value is the sample's distance from its fitted plane: |z| within the foot points' spread.
+    EXPECT_NEAR(cells.distance[k], std::abs(cells.point[k].z()), 0.01) << "sample " << k;
+  }
+  std::sort(tilt.begin(), tilt.end());
+  EXPECT_LT(tilt[tilt.size() / 2], 3.0) << "median tilt of the fitted planes (the gradients': 15)";
+  EXPECT_LT(tilt.back(), 10.0);
+}
+
+// Two parallel sheets z = +-a closer than a fit's neighbourhood: samples above the upper sheet and those
+// just below the middle both point up, and their foot points lie on both sheets. A plane through them would
+// sit between the sheets; such a fit is no plane, and the samples keep their own.
+TEST(FittedSamplePlanes, FootPointsOnTwoSheetsGiveNoPlane) {
+  const double a = 0.015;
+  CellSamples cells = PlaneCell(0.0, 100, 0.1, 5);
+  for (size_t k = 0; k < cells.point.size(); ++k) {
+    const double z = cells.point[k].z(), to = z >= 0 ? a : -a;  // the nearer sheet
+    cells.distance[k] = std::abs(z - to);
+    cells.gradient[k] = Vec3(0, 0, z >= to ? 1.0 : -1.0);
+  }
+  const CellSamples exact = cells;
+  EXPECT_EQ(FitSamplePlanes(cells, SamplePlaneFit{}), 0.0);
+  for (size_t k = 0; k < cells.point.size(); ++k) {
+    EXPECT_LT((cells.gradient[k] - exact.gradient[k]).norm(), 1e-9) << "sample " << k;
+    EXPECT_NEAR(cells.distance[k], exact.distance[k], 1e-12) << "sample " << k;
+  }
+}
+
+TEST(FittedSamplePlanes, ExactGradientsOnAPlaneAreLeftAsTheyAre) {
+  const CellSamples exact = PlaneCell(0.0, 100, 0.1, 4);
+  CellSamples cells = exact;
+  EXPECT_LT(FitSamplePlanes(cells, SamplePlaneFit{}), 1e-6);
+  for (size_t k = 0; k < cells.point.size(); ++k) {
+    EXPECT_LT((cells.gradient[k] - exact.gradient[k]).norm(), 1e-9) << "sample " << k;
+    EXPECT_NEAR(cells.distance[k], exact.distance[k], 1e-12) << "sample " << k;
+  }
+}
 
 // ---------------------------------------------------------------------------------------------- L1 solver
 
@@ -745,6 +815,33 @@ TEST(OptimizeSeeds, GradientErrorsThatFoolTheRankTestDoNotInflateTheCount) {
   EXPECT_GE(out.size(), 700u);
 }
 
+// Gradients turned by 15° tilt the planes whose crossing puts a seed on a cube edge; the planes fitted to
+// the foot points (--sample-planes auto, the default, measures the error and fits) put the edge seeds back
+// on the edges. On the exact cube auto measures no error and keeps the paper's planes: the same seeds.
+TEST(OptimizeSeeds, FittedSamplePlanesPutTheEdgeSeedsOfANoisyCubeBackOnTheEdges) {
+  const auto noisy = OpenUdf("noisy:grad=15,seed=0:shape:cube");
+  auto edge_error = [&](const std::string& planes) {
+    OptimizeSeedsOptions o;
+    o.sample_planes = planes;
+    const SeedCloud out = OptimizeSeeds(*noisy, Initial(*noisy, 600, 3), o, Monitor::Null());
+    std::vector<double> e;
+    for (size_t i = 0; i < out.size(); ++i)
+      if (out.rank[i] == 2) e.push_back(CubeEdgeDistance(out.position[i]));
+    std::sort(e.begin(), e.end());
+    return e.empty() ? INFINITY : e[e.size() / 2];
+  };
+  const double fitted = edge_error("auto"), turned = edge_error("gradient");
+  EXPECT_LT(fitted, 0.5 * turned) << "median distance of the rank-2 seeds from the edges";
+
+  const auto cube = MakeShape("cube");
+  OptimizeSeedsOptions a, g;
+  g.sample_planes = "gradient";
+  const SeedCloud by_auto = OptimizeSeeds(*cube, Initial(*cube, 300, 5), a, Monitor::Null());
+  const SeedCloud by_gradient = OptimizeSeeds(*cube, Initial(*cube, 300, 5), g, Monitor::Null());
+  ASSERT_EQ(by_auto.size(), by_gradient.size());
+  for (size_t i = 0; i < by_auto.size(); ++i) EXPECT_EQ(by_auto.position[i], by_gradient.position[i]);
+}
+
 // --repulsion-cells first draws no cells in an outer iteration's later repulsion rounds: fewer queries, and
 // the ranks those rounds keep still put every corner and as many seeds on the edges.
 TEST(OptimizeSeeds, RepulsionRoundsOnTheFirstRoundsCellsAskLessAndKeepTheFeatures) {
@@ -1038,6 +1135,9 @@ TEST(OptimizeSeeds, BadOptionsAndInputs) {
   EXPECT_THROW(o.Check(), UsageError);
   o.feature_gap_max = 0.0;
   EXPECT_NO_THROW(o.Check());
+  o = OptimizeSeedsOptions();
+  o.sample_planes = "fitted";  // fit, gradient or auto
+  EXPECT_THROW(o.Check(), UsageError);
   const auto sphere = MakeShape("sphere");
   SeedCloud one;
   one.Resize(1);

@@ -35,6 +35,7 @@ int main(int argc, char** argv) {
   app.add_option("--lbfgs-max-iters", o.lbfgs_max_iters, "L-BFGS iterations per repulsion round");
   app.add_option("--rank-threshold", o.rank_threshold, "rank(A) counts singular values above this fraction of the largest");
   app.add_option("--crease-angle-deg", o.crease_angle_deg, "a sheet cell whose normals show two planes this many degrees apart (below 2 atan(--rank-threshold)) is a crease (0: off)");
+  app.add_option("--sample-planes", o.sample_planes, "gradient: a cell sample's tangent plane is its gradient's (the paper); fit: fitted to the surface points the cell's samples point at (gradient errors); auto: fit when the gradients are off those planes by more than 8 deg and more than the value errors explain");
   app.add_option("--rank-noise", o.rank_noise, "take the normal spread no surface explains (gradient errors) out of the rank test");
   app.add_option("--cell-knn", o.cell_knn, "cells are bounded by a ball sized by the distance to this nearest seed");
   app.add_option("--cell-radius-factor", o.cell_radius_factor, "ball radius / distance to the --cell-knn-th seed");

@@ -42,6 +42,8 @@ void OptimizeSeedsOptions::Check() const {
   if (repulsion_cells != "every" && repulsion_cells != "first") throw UsageError("--repulsion-cells must be every or first");
   if (l1_curve_step != "auto" && l1_curve_step != "free" && l1_curve_step != "across")
     throw UsageError("--l1-curve-step must be auto, free or across");
+  if (sample_planes != "gradient" && sample_planes != "fit" && sample_planes != "auto")
+    throw UsageError("--sample-planes must be gradient, fit or auto");
   if (!(pool_layers >= 1 && pool_layers <= 64)) throw UsageError("--pool-layers must be in [1, 64]");
   if (!(sigma_max_spacing >= 0.0 && sigma_max_spacing <= 10.0)) throw UsageError("--sigma-max-spacing must be in [0, 10]");
   if (!(sigma_min_spacing >= 0.0 && sigma_min_spacing <= 10.0)) throw UsageError("--sigma-min-spacing must be in [0, 10]");
@@ -103,9 +105,10 @@ void CountRanks(const SeedState& s, OuterIterationReport& report) {
 }
 
 // Input seeds on the zero set, in input order, without exact duplicates (their repulsion has no direction);
-// *twin_within: the twin separation their projection measured (common/projection.h).
+// *twin_within: the twin separation their projection measured (common/projection.h); *value_tilt: how far
+// the field's value errors tilt its zero set, from the seeds that stopped at a floor or ridge (ValueErrorTilt).
 SeedState Prepare(const Udf& udf, const SeedCloud& input, const ProjectionOptions& projection, Monitor& monitor,
-                  double* twin_within) {
+                  double* twin_within, double* value_tilt) {
   if (input.size() < 2)
     throw InputError("input seeds", "has " + std::to_string(input.size()) + " seed(s); optimize-seeds needs at least 2");
   std::vector<size_t> order(input.size());
@@ -130,6 +133,11 @@ SeedState Prepare(const Udf& udf, const SeedCloud& input, const ProjectionOption
   *twin_within = r.twin_within;
   if (r.twin_within > 0.0)
     monitor.Info(TwinSheetsSummary(r, udf.Domain().Diagonal(), "seeds"));
+  std::vector<Vec3> at_floor;
+  std::vector<double> floor;
+  for (size_t i = 0; i < points.size(); ++i)
+    if (r.converged[i] && r.distance[i] >= projection.tolerance) at_floor.push_back(points[i]), floor.push_back(r.distance[i]);
+  *value_tilt = ValueErrorTilt(at_floor, floor);
   for (size_t i = 0; i < points.size(); ++i) {
     if (!r.converged[i]) continue;
     s.position.push_back(points[i]);
@@ -307,9 +315,10 @@ SeedCloud OptimizeSeeds(const Udf& udf, const SeedCloud& input, const OptimizeSe
   using Clock = std::chrono::steady_clock;
   const auto start = Clock::now();
   Optimizer opt(udf, options, monitor);
-  double twin_within = 0.0;
-  SeedState s = Prepare(udf, input, opt.projection(), monitor, &twin_within);
+  double twin_within = 0.0, value_tilt = 0.0;
+  SeedState s = Prepare(udf, input, opt.projection(), monitor, &twin_within, &value_tilt);
   opt.SetTwinWithin(twin_within);
+  opt.SetValueErrorTilt(value_tilt);
   const size_t n = s.position.size();
   const auto [spacing_in, cv_in] = opt.SpacingStats(s.position);
   // Buckets of 1.5 spacings: a cell's ball (radius ~0.8 spacing) meets 8-27, whose points are scanned in one

@@ -45,6 +45,12 @@ struct OptimizeSeedsOptions {
   /// spread no surface explains: gradient errors), so that a noisy sheet is not a crease; off (default): the
   /// paper's test. Off by default: on feature-dense parts the median s_3/s_1 is geometry, not noise (docs).
   bool rank_noise = false;
+  /// --sample-planes: gradient: each cell sample's tangent plane is its gradient's (the paper); fit: fitted to
+  /// the foot points of the cell's samples (FitSamplePlanes; fields with gradient errors); auto: fit when the
+  /// first cells' gradients are off those planes by more than sample_planes_auto_deg and by more than the
+  /// field's value errors explain (FitPaysOff).
+  std::string sample_planes = "auto";
+  double sample_planes_auto_deg = 8.0;
   int cell_knn = 6;               ///< the cell's bounding ball has radius cell_radius_factor × distance to the k-th nearest seed (--cell-knn)
   double cell_radius_factor = 0.5;///< (--cell-radius-factor)
   double sigma_max_spacing = 0.5; ///< σ ≤ this × mean nearest-neighbour distance; 0: no cap (--sigma-max-spacing)

@@ -99,6 +99,21 @@ CellSamples Optimizer::Analyze(SeedState& s, bool early) {
     CarryCells(s.position, cell_options, cached_cells_, cached_positions_);
   CellSamples cells = SampleVoronoiCells(udf_, s.position, index, cell_options, options_.seed, round_++,
                                          cached_positions_.empty() ? nullptr : &cached_cells_, &cached_positions_);
+  // The cache keeps the field's own values and gradients: a kept cell is fitted afresh.
+  cached_cells_ = cells;
+  cached_positions_ = s.position;
+  if (fit_planes_ != 0) {
+    const SamplePlaneFit fit;
+    if (fit_planes_ < 0) {
+      gradient_error_ = MeasureGradientError(cells, fit);
+      fit_planes_ = FitPaysOff(gradient_error_, value_tilt_, options_.sample_planes_auto_deg * M_PI / 180.0) ? 1 : 0;
+      monitor_.Info(Format("gradients %.1f deg off the planes of their foot points (median), value errors tilt "
+                           "the zero set %.1f deg: %s", gradient_error_ * 180.0 / M_PI, value_tilt_ * 180.0 / M_PI,
+                           fit_planes_ ? "sample planes fitted" : "sample planes from the gradients"));
+    }
+    if (fit_planes_ > 0) gradient_error_ = FitSamplePlanes(cells, fit);
+    monitor_.Debug(Format("sample planes: gradients %.2f deg off (median)", gradient_error_ * 180.0 / M_PI));
+  }
   const long n = static_cast<long>(s.position.size());
   std::vector<TangentRank> ranks(static_cast<size_t>(n));
 #pragma omp parallel for schedule(static)
@@ -130,8 +145,6 @@ CellSamples Optimizer::Analyze(SeedState& s, bool early) {
     }
     s.rank[i] = r;
   }
-  cached_cells_ = cells;
-  cached_positions_ = s.position;
   last_short_cells_ = cells.short_cells;
   if (cells.draws) last_acceptance_ = static_cast<double>(cells.drawn_samples) / static_cast<double>(cells.draws);
   monitor_.Debug("cells: " + std::to_string(cells.redrawn) + " of " + std::to_string(n) + " redrawn, " +

@@ -12,6 +12,7 @@
 #include "common/projection.h"
 #include "common/udf.h"
 #include "stages/optimize-seeds/feature_seeds.h"
+#include "stages/optimize-seeds/fitted_normals.h"
 #include "stages/optimize-seeds/l1_tangent.h"
 #include "stages/optimize-seeds/optimize_seeds.h"
 #include "stages/optimize-seeds/repulsion.h"
@@ -120,6 +121,8 @@ class Optimizer {
   const ProjectionOptions& projection() const { return projection_; }
   /// Every later projection takes zero sheets closer than this for one (Prepare measures it).
   void SetTwinWithin(double within) { projection_.twin_within = within; }
+  /// --sample-planes auto fits only where the gradients are off by more than this explains (ValueErrorTilt).
+  void SetValueErrorTilt(double radians) { value_tilt_ = radians; }
 
  private:
   const Udf& udf_;
@@ -138,7 +141,11 @@ class Optimizer {
   double crease_angle_ = options_.crease_angle_deg * M_PI / 180.0;
   double crease_max_angle_ = BlindCreaseAngle(options_.rank_threshold);
   double crease_share_ = SecondPlaneShare(options_.rank_threshold);
-  double normal_spread_ = 0.0;  ///< the last Analyze's UnexplainedNormalSpread (0 with --rank-noise off)
+  double normal_spread_ = 0.0;
+  // --sample-planes: 1 fit, 0 gradient, -1 auto (undecided until the first cells are measured).
+  int fit_planes_ = options_.sample_planes == "fit" ? 1 : options_.sample_planes == "auto" ? -1 : 0;
+  double gradient_error_ = 0.0;  ///< radians, the last measured median (FitSamplePlanes)
+  double value_tilt_ = 0.0;      ///< radians (SetValueErrorTilt)  ///< the last Analyze's UnexplainedNormalSpread (0 with --rank-noise off)
 };
 
 }  // namespace voroudf

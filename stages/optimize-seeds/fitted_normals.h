@@ -1,0 +1,56 @@
+#pragma once
+// Tangent planes of the cell samples fitted to the surface points they point at, for fields whose gradients
+// are wrong while their values are right (docs/optimize-seeds.md, "Fitted sample planes").
+#include <cstddef>
+#include <vector>
+
+#include "stages/optimize-seeds/voronoi_cells.h"
+
+namespace voroudf {
+
+struct SamplePlaneFit {
+  int neighbours = 10;          ///< k: foot points per fit (the sample's own and its k − 1 nearest that agree)
+  double agree_deg = 45.0;      ///< only samples whose gradients are this close to the sample's own take part
+  int min_neighbours = 5;       ///< fewer agreeing foot points in the cell: the sample keeps its gradient's plane
+  /// a fit whose foot points spread across their plane by more than this × along it (√(λ₀/λ₁)) is no plane;
+  /// a sample whose foot point is farther than this × that spread from a plane does not take it
+  double max_thickness = 0.25;
+  int anchor_stride = 2;        ///< planes are fitted at every this-th sample; the others take the nearest one's (4: worse CD and TD)
+};
+
+/// Sample m of a cell, at p_m with value d_m and gradient g_m, stands for the plane through its foot point
+/// f_m = p_m − d_m g_m with normal g_m (paper Eq. `energy_l1`: |g_mᵀ(p_m − x) − d_m|). A gradient turned by
+/// θ tilts that plane by θ, but moves the foot point off the surface by only d_m (1 − cos θ) (3.4 % of d_m at
+/// 15°): the foot points keep the surface where the gradients lose it. So each sample's plane becomes the
+/// total-least-squares plane of the foot points of its own cell nearest its own (PCA; Hoppe et al. 1992),
+/// among the samples whose gradients agree with its own within `agree_deg` (the same face of a crease):
+/// gradient ← that plane's unit normal n̂ (turned towards g_m), distance ← n̂ᵀ(p_m − c̄), c̄ the neighbours'
+/// centroid. On a plane with exact gradients this is the same plane.
+/// A fit whose foot points are no plane (√(λ₀/λ₁) > max_thickness: sheets closer than the neighbourhood, a
+/// corner) is dropped; a sample takes the plane of the nearest fitted anchor that agrees with it and whose plane
+/// its own foot point lies on (within max_thickness × the fit's spread), else keeps its gradient's plane.
+/// Returns the median over the samples of the angle between the gradient and the plane's normal (0 where the
+/// gradient's plane was kept): the field's gradient error where its surface is a plane within a fit.
+double FitSamplePlanes(CellSamples& cells, const SamplePlaneFit& fit);
+
+/// The same median angle as FitSamplePlanes, without changing the cells.
+double MeasureGradientError(const CellSamples& cells, const SamplePlaneFit& fit);
+
+/// How far a field's value errors tilt its zero set (radians), from the values `floor` at `points` where a
+/// projection stopped at a floor or ridge (|d + e| = |e| there, common/projection.h): atan(s / cos 45°), s
+/// the median over the points of |Δ floor| / |Δ x| to the nearest other such point (a slope along a random
+/// direction; its median is |∇e| cos 45° for a fixed gradient). The foot points lie on the field's zero
+/// set, so their planes are off the surface by about this much where the gradients are exact. 0 with fewer
+/// than 16 points.
+double ValueErrorTilt(const std::vector<Vec3>& points, const std::vector<double>& floor);
+
+/// --sample-planes auto's rule: fit when the gradients' measured angle to the fitted planes, `measured`,
+/// exceeds `min_angle` and 4 × `value_tilt`. Value errors alone make the gradients measure up to 2.4 × the tilt
+/// ValueErrorTilt estimates (noisy:value= from 1e-3 to 1e-2, CAD, cloth and non-manifold shapes: the foot
+/// points scatter as the error varies along each sample's height, besides the tilt), and there the gradients
+/// are the better planes; beyond 4 × that, the rest is the gradients' own error. Radians.
+inline bool FitPaysOff(double measured, double value_tilt, double min_angle) {
+  return measured > min_angle && measured > 4.0 * value_tilt;
+}
+
+}  // namespace voroudf
