@@ -106,10 +106,11 @@ double Median(std::vector<double>& v) {
   return *mid;
 }
 
-double Fit(CellSamples& cells, const SamplePlaneFit& fit, bool apply) {
+// The planes of every cell into normal/distance (initialised to the field's); returns the median angle.
+double Fit(const CellSamples& cells, const SamplePlaneFit& fit, std::vector<Vec3>& normal, std::vector<double>& distance) {
   const long n = static_cast<long>(cells.sample_offset.size()) - 1;
-  std::vector<Vec3> normal = cells.gradient;
-  std::vector<double> distance = cells.distance;
+  normal = cells.gradient;
+  distance = cells.distance;
   std::vector<std::vector<double>> angles(static_cast<size_t>(std::max(n, 0L)));
 #pragma omp parallel for schedule(dynamic, 16)
   for (long i = 0; i < n; ++i)
@@ -117,16 +118,19 @@ double Fit(CellSamples& cells, const SamplePlaneFit& fit, bool apply) {
             normal, distance, angles[static_cast<size_t>(i)]);
   std::vector<double> all;
   for (const auto& a : angles) all.insert(all.end(), a.begin(), a.end());
-  if (apply) {
-    cells.gradient.swap(normal);
-    cells.distance.swap(distance);
-  }
   return Median(all);
 }
 
 }  // namespace
 
-double FitSamplePlanes(CellSamples& cells, const SamplePlaneFit& fit) { return Fit(cells, fit, true); }
+double FitSamplePlanes(CellSamples& cells, const SamplePlaneFit& fit) {
+  std::vector<Vec3> normal;
+  std::vector<double> distance;
+  const double angle = Fit(cells, fit, normal, distance);
+  cells.gradient.swap(normal);
+  cells.distance.swap(distance);
+  return angle;
+}
 
 double ValueErrorTilt(const std::vector<Vec3>& points, const std::vector<double>& floor) {
   if (points.size() < 16) return 0.0;
@@ -146,8 +150,9 @@ double ValueErrorTilt(const std::vector<Vec3>& points, const std::vector<double>
 }
 
 double MeasureGradientError(const CellSamples& cells, const SamplePlaneFit& fit) {
-  CellSamples copy = cells;
-  return Fit(copy, fit, false);
+  std::vector<Vec3> normal;
+  std::vector<double> distance;
+  return Fit(cells, fit, normal, distance);
 }
 
 }  // namespace voroudf
