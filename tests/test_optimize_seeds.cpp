@@ -91,6 +91,27 @@ TEST(FittedSamplePlanes, FootPointsOnTwoSheetsGiveNoPlane) {
   }
 }
 
+// A value error with slope c along the surface tilts the zero set by atan c: floors read from random points
+// of a plane with e = 1e-3 + c x give it back (the slope to the nearest point along a random direction has
+// median c cos 45°).
+TEST(FittedSamplePlanes, TheValueErrorsTiltIsTheirSlopeAlongTheSurface) {
+  Rng rng(6, 0);
+  std::vector<Vec3> points;
+  std::vector<double> floor, flat;
+  for (int k = 0; k < 2000; ++k) {
+    points.emplace_back(rng.Uniform(-1, 1), rng.Uniform(-1, 1), 0.0);
+    floor.push_back(1e-3 + 0.1 * points.back().x());
+    flat.push_back(1e-3);
+  }
+  EXPECT_NEAR(ValueErrorTilt(points, floor), std::atan(0.1), 0.1 * std::atan(0.1));
+  EXPECT_EQ(ValueErrorTilt(points, flat), 0.0);
+  points.resize(15), floor.resize(15);
+  EXPECT_EQ(ValueErrorTilt(points, floor), 0.0);  // too few to say
+  EXPECT_TRUE(FitPaysOff(0.26, 0.02, 8 * M_PI / 180));   // 15° against a 1.1° tilt
+  EXPECT_FALSE(FitPaysOff(0.08, 0.035, 8 * M_PI / 180)); // 4.6° against 2°: the value errors' own scatter
+  EXPECT_FALSE(FitPaysOff(0.10, 0.0, 8 * M_PI / 180));   // 5.7°: below the floor
+}
+
 TEST(FittedSamplePlanes, ExactGradientsOnAPlaneAreLeftAsTheyAre) {
   const CellSamples exact = PlaneCell(0.0, 100, 0.1, 4);
   CellSamples cells = exact;
