@@ -85,15 +85,18 @@ void MergeTwinSheets(const Udf& udf, std::vector<Vec3>& points, ProjectionResult
   to_twin.max_iterations = 8;
   const ProjectionResult twin = ProjectToZeroSet(udf, twin_at, to_twin, Monitor::Null());
   std::vector<double> separation(owner.size(), -1.0);  // -1: no twin
-  std::vector<Vec3> quarters(2 * owner.size());
+  std::vector<size_t> quarter_at(owner.size(), SIZE_MAX);  // per candidate with a twin: its quarter points
+  std::vector<Vec3> quarters;
   for (size_t c = 0; c < owner.size(); ++c) {
     const Vec3& p = points[probed[owner[c]]];
     const double t = (twin_at[c] - p).norm();
-    quarters[2 * c] = p + 0.25 * (twin_at[c] - p);
-    quarters[2 * c + 1] = p + 0.75 * (twin_at[c] - p);
     // Closer than 8 tolerances may be the point's own sheet: a converged point lies within a tolerance over the
     // field's slope of it, on either side, and the slopes below are not measurable there.
-    if (twin.converged[c] && t < within && t > 8.0 * tolerance) separation[c] = t;
+    if (!(twin.converged[c] && t < within && t > 8.0 * tolerance)) continue;
+    separation[c] = t;
+    quarter_at[c] = quarters.size();
+    quarters.push_back(p + 0.25 * (twin_at[c] - p));
+    quarters.push_back(p + 0.75 * (twin_at[c] - p));
   }
   // Between the sheets |d + e| = |e| - d rises from each sheet to a kink on the surface (d = 0), at slopes
   // 1 -+ the error's own slope along the line. The quarter points measure both slopes a_p, a_t; where both are
@@ -105,7 +108,7 @@ void MergeTwinSheets(const Udf& udf, std::vector<Vec3>& points, ProjectionResult
   for (size_t c = 0; c < owner.size(); ++c) {
     const double t = separation[c];
     if (!(t > 0.0)) continue;
-    const double a_p = d[2 * c] / (0.25 * t), a_t = d[2 * c + 1] / (0.25 * t);
+    const double a_p = d[quarter_at[c]] / (0.25 * t), a_t = d[quarter_at[c] + 1] / (0.25 * t);
     if (!(a_p >= 0.5 && a_p <= 1.5 && a_t >= 0.5 && a_t <= 1.5)) continue;  // not a ridge
     const Vec3& p = points[probed[owner[c]]];
     ridge[c] = p + (a_t / (a_p + a_t)) * (twin_at[c] - p);

@@ -191,15 +191,16 @@ TEST(Projection, SeedsOfANoisySphereAreKeptAndNearIt) {
   EXPECT_LT(SampleSeeds(*noisy, options, Monitor::Null()).size(), 700u);
 }
 
-// |d + e| for the plane z = 0 with a constant error: e = +a (a floor of height a) where x < 0, e = -a (two
-// zero sheets at z = +-a, a ridge of height a on the plane between them) where x >= 0. Gradients as the
-// noisy: wrapper gives them: the plane's, times the sign of d + e.
+// |d + e| for the plane z = 0 with the error e = +a (a floor of height a) where x < 0, e = -a (two zero
+// sheets at z = +-a, a ridge of height a on the plane between them) where x >= 0, plus `slope` z. Gradients as
+// the noisy: wrapper gives them: the plane's, times the sign of d + e.
 class FloorAndTwins final : public Udf {
  public:
-  explicit FloorAndTwins(double a, bool floor_half = true) : a_(a), floor_half_(floor_half) {}
+  explicit FloorAndTwins(double a, bool floor_half = true, double slope = 0.0)
+      : a_(a), floor_half_(floor_half), slope_(slope) {}
   void EvaluateChunk(const Vec3* p, size_t count, double* d, Vec3* g) const override {
     for (size_t i = 0; i < count; ++i) {
-      const double z = p[i].z(), e = floor_half_ && p[i].x() < 0 ? a_ : -a_;
+      const double z = p[i].z(), e = (floor_half_ && p[i].x() < 0 ? a_ : -a_) + slope_ * z;
       d[i] = std::abs(std::abs(z) + e);
       g[i] = Vec3(0, 0, (z < 0 ? -1.0 : 1.0) * (std::abs(z) + e < 0 ? -1.0 : 1.0));
     }
@@ -210,6 +211,7 @@ class FloorAndTwins final : public Udf {
  private:
   double a_;
   bool floor_half_;
+  double slope_;  // of the error along z
 };
 
 std::vector<Vec3> SlabPoints(size_t n, double half_height, uint64_t seed) {
@@ -250,26 +252,9 @@ TEST(Projection, TwinSheetsOfAFieldWithAFloorGoToTheRidgeBetweenThem) {
 // field rises at 1 - c = 0.8 < cos 30° away from its zero sheet, so a probe there reads like one that has
 // passed a twin although none lies beyond it. The sheets lie at z = a / 1.2 and -a / 0.8, their midpoint
 // at -0.21 a, the ridge's top (the kink of |z|) on the plane.
-class SlantedTwins final : public Udf {
- public:
-  explicit SlantedTwins(double a) : a_(a) {}
-  void EvaluateChunk(const Vec3* p, size_t count, double* d, Vec3* g) const override {
-    for (size_t i = 0; i < count; ++i) {
-      const double z = p[i].z(), e = (p[i].x() < 0 ? a_ : -a_) + 0.2 * z;
-      d[i] = std::abs(std::abs(z) + e);
-      g[i] = Vec3(0, 0, (z < 0 ? -1.0 : 1.0) * (std::abs(z) + e < 0 ? -1.0 : 1.0));
-    }
-  }
-  Box Domain() const override { return {Vec3::Constant(-1), Vec3::Constant(1)}; }
-  std::string Describe() const override { return "slanted twins"; }
-
- private:
-  double a_;
-};
-
 TEST(Projection, TwinSheetsWhoseErrorVariesAlongTheNormalGoToTheRidgeFromBothSides) {
   const double a = 2e-3;
-  const SlantedTwins udf(a);
+  const FloorAndTwins udf(a, true, 0.2);
   const std::vector<Vec3> start = SlabPoints(600, 0.05, 7);
   ProjectionOptions options;
   options.tolerance = 1e-6;  // Newton converges by 0.2 a step on slopes of 1.2 and 0.8

@@ -56,10 +56,10 @@ CellSamples PlaneCell(double deg, size_t m, double r, uint64_t seed) {
 // only d (1 - cos θ): the planes fitted to the foot points are the face's, within a few degrees.
 TEST(FittedSamplePlanes, GradientsTurnedBy15DegreesGiveTheFacesPlaneBack) {
   CellSamples cells = PlaneCell(15.0, 100, 0.1, 3);
-  const double measured = MeasureGradientError(cells, SamplePlaneFit{});
-  const double fitted = FitSamplePlanes(cells, SamplePlaneFit{});
-  EXPECT_NEAR(measured * 180 / M_PI, 15.0, 2.0);
-  EXPECT_DOUBLE_EQ(fitted, measured);
+  SamplePlanes planes = FitSamplePlanes(cells, SamplePlaneFit{});
+  EXPECT_NEAR(planes.median_angle * 180 / M_PI, 15.0, 2.0);
+  EXPECT_DOUBLE_EQ(FitSamplePlanes(cells, SamplePlaneFit{}).median_angle, planes.median_angle);  // cells untouched
+  UseSamplePlanes(cells, planes);
   std::vector<double> tilt;
   for (size_t k = 0; k < cells.point.size(); ++k) {
     const double side = cells.point[k].z() < 0 ? -1.0 : 1.0;
@@ -84,7 +84,9 @@ TEST(FittedSamplePlanes, FootPointsOnTwoSheetsGiveNoPlane) {
     cells.gradient[k] = Vec3(0, 0, z >= to ? 1.0 : -1.0);
   }
   const CellSamples exact = cells;
-  EXPECT_EQ(FitSamplePlanes(cells, SamplePlaneFit{}), 0.0);
+  SamplePlanes planes = FitSamplePlanes(cells, SamplePlaneFit{});
+  EXPECT_EQ(planes.median_angle, 0.0);
+  UseSamplePlanes(cells, planes);
   for (size_t k = 0; k < cells.point.size(); ++k) {
     EXPECT_LT((cells.gradient[k] - exact.gradient[k]).norm(), 1e-9) << "sample " << k;
     EXPECT_NEAR(cells.distance[k], exact.distance[k], 1e-12) << "sample " << k;
@@ -115,7 +117,9 @@ TEST(FittedSamplePlanes, TheValueErrorsTiltIsTheirSlopeAlongTheSurface) {
 TEST(FittedSamplePlanes, ExactGradientsOnAPlaneAreLeftAsTheyAre) {
   const CellSamples exact = PlaneCell(0.0, 100, 0.1, 4);
   CellSamples cells = exact;
-  EXPECT_LT(FitSamplePlanes(cells, SamplePlaneFit{}), 1e-6);
+  SamplePlanes planes = FitSamplePlanes(cells, SamplePlaneFit{});
+  EXPECT_LT(planes.median_angle, 1e-6);
+  UseSamplePlanes(cells, planes);
   for (size_t k = 0; k < cells.point.size(); ++k) {
     EXPECT_LT((cells.gradient[k] - exact.gradient[k]).norm(), 1e-9) << "sample " << k;
     EXPECT_NEAR(cells.distance[k], exact.distance[k], 1e-12) << "sample " << k;

@@ -106,30 +106,27 @@ double Median(std::vector<double>& v) {
   return *mid;
 }
 
-// The planes of every cell into normal/distance (initialised to the field's); returns the median angle.
-double Fit(const CellSamples& cells, const SamplePlaneFit& fit, std::vector<Vec3>& normal, std::vector<double>& distance) {
+}  // namespace
+
+SamplePlanes FitSamplePlanes(const CellSamples& cells, const SamplePlaneFit& fit) {
   const long n = static_cast<long>(cells.sample_offset.size()) - 1;
-  normal = cells.gradient;
-  distance = cells.distance;
+  SamplePlanes planes;
+  planes.normal = cells.gradient;
+  planes.distance = cells.distance;
   std::vector<std::vector<double>> angles(static_cast<size_t>(std::max(n, 0L)));
 #pragma omp parallel for schedule(dynamic, 16)
   for (long i = 0; i < n; ++i)
     FitCell(cells, cells.sample_offset[static_cast<size_t>(i)], cells.sample_offset[static_cast<size_t>(i) + 1], fit,
-            normal, distance, angles[static_cast<size_t>(i)]);
+            planes.normal, planes.distance, angles[static_cast<size_t>(i)]);
   std::vector<double> all;
   for (const auto& a : angles) all.insert(all.end(), a.begin(), a.end());
-  return Median(all);
+  planes.median_angle = Median(all);
+  return planes;
 }
 
-}  // namespace
-
-double FitSamplePlanes(CellSamples& cells, const SamplePlaneFit& fit) {
-  std::vector<Vec3> normal;
-  std::vector<double> distance;
-  const double angle = Fit(cells, fit, normal, distance);
-  cells.gradient.swap(normal);
-  cells.distance.swap(distance);
-  return angle;
+void UseSamplePlanes(CellSamples& cells, SamplePlanes& planes) {
+  cells.gradient.swap(planes.normal);
+  cells.distance.swap(planes.distance);
 }
 
 double ValueErrorTilt(const std::vector<Vec3>& points, const std::vector<double>& floor) {
@@ -147,12 +144,6 @@ double ValueErrorTilt(const std::vector<Vec3>& points, const std::vector<double>
     }
   }
   return std::atan(Median(slope) / std::cos(M_PI / 4.0));
-}
-
-double MeasureGradientError(const CellSamples& cells, const SamplePlaneFit& fit) {
-  std::vector<Vec3> normal;
-  std::vector<double> distance;
-  return Fit(cells, fit, normal, distance);
 }
 
 }  // namespace voroudf

@@ -18,6 +18,15 @@ struct SamplePlaneFit {
   int anchor_stride = 2;        ///< planes are fitted at every this-th sample; the others take the nearest one's (4: worse CD and TD)
 };
 
+/// Per sample of a CellSamples: the normal and value of its tangent plane, and over all samples the median
+/// angle between the gradient and that normal (0 where the gradient's plane was kept): the field's gradient
+/// error where its surface is a plane within a fit.
+struct SamplePlanes {
+  std::vector<Vec3> normal;
+  std::vector<double> distance;
+  double median_angle = 0.0;  ///< radians
+};
+
 /// Sample m of a cell, at p_m with value d_m and gradient g_m, stands for the plane through its foot point
 /// f_m = p_m − d_m g_m with normal g_m (paper Eq. `energy_l1`: |g_mᵀ(p_m − x) − d_m|). A gradient turned by
 /// θ tilts that plane by θ, but moves the foot point off the surface by only d_m (1 − cos θ) (3.4 % of d_m at
@@ -29,12 +38,11 @@ struct SamplePlaneFit {
 /// A fit whose foot points are no plane (√(λ₀/λ₁) > max_thickness: sheets closer than the neighbourhood, a
 /// corner) is dropped; a sample takes the plane of the nearest fitted anchor that agrees with it and whose plane
 /// its own foot point lies on (within max_thickness × the fit's spread), else keeps its gradient's plane.
-/// Returns the median over the samples of the angle between the gradient and the plane's normal (0 where the
-/// gradient's plane was kept): the field's gradient error where its surface is a plane within a fit.
-double FitSamplePlanes(CellSamples& cells, const SamplePlaneFit& fit);
+/// The cells are left as they are: UseSamplePlanes puts the result in.
+SamplePlanes FitSamplePlanes(const CellSamples& cells, const SamplePlaneFit& fit);
 
-/// The same median angle as FitSamplePlanes, without changing the cells.
-double MeasureGradientError(const CellSamples& cells, const SamplePlaneFit& fit);
+/// The cells' gradients and values become `planes`' normals and distances (swapped in).
+void UseSamplePlanes(CellSamples& cells, SamplePlanes& planes);
 
 /// How far a field's value errors tilt its zero set (radians), from the values `floor` at `points` where a
 /// projection stopped at a floor or ridge (|d + e| = |e| there, common/projection.h): atan(s / cos 45°), s

@@ -103,15 +103,15 @@ CellSamples Optimizer::Analyze(SeedState& s, bool early) {
   cached_cells_ = cells;
   cached_positions_ = s.position;
   if (fit_planes_ != 0) {
-    const SamplePlaneFit fit;
+    SamplePlanes planes = FitSamplePlanes(cells, SamplePlaneFit{});
+    gradient_error_ = planes.median_angle;
     if (fit_planes_ < 0) {
-      gradient_error_ = MeasureGradientError(cells, fit);
       fit_planes_ = FitPaysOff(gradient_error_, value_tilt_, options_.sample_planes_auto_deg * M_PI / 180.0) ? 1 : 0;
       monitor_.Info(Format("gradients %.1f deg off the planes of their foot points (median), value errors tilt "
                            "the zero set %.1f deg: %s", gradient_error_ * 180.0 / M_PI, value_tilt_ * 180.0 / M_PI,
                            fit_planes_ ? "sample planes fitted" : "sample planes from the gradients"));
     }
-    if (fit_planes_ > 0) gradient_error_ = FitSamplePlanes(cells, fit);
+    if (fit_planes_ > 0) UseSamplePlanes(cells, planes);
     monitor_.Debug(Format("sample planes: gradients %.2f deg off (median)", gradient_error_ * 180.0 / M_PI));
   }
   const long n = static_cast<long>(s.position.size());
