@@ -37,11 +37,77 @@ double EstimateTwinWithin(const ProjectionResult& result, double tolerance, doub
   return factor * floors[q];
 }
 
+namespace {
+
+// Probes at three distances: a tilted gradient reads a probe short by r (1 - cos tilt), so a probe at r
+// tells twins apart only beyond 0.13 r; the near ones find the close twins, the far one the rest.
+constexpr std::array<double, 3> kScales = {0.25, 0.5, 1.0};
+
+// A kink before the near probe (MergeTwinSheets' second rule): the field there no longer rises at 1 and its
+// gradient along the line, slope, is at most 0.3 (past a sheet it reads about +1); with a_p = 1 for now, the
+// kink is where the rise from the point meets the line through the probe at that slope. Returns its distance,
+// or -1.
+double KinkBeforeProbe(double f, double slope, double r, double tolerance) {
+  if (!(f < std::cos(M_PI / 6.0) * r && slope <= 0.3 && slope >= -1.5)) return -1.0;
+  const double s = (f - slope * r) / (1.0 - slope);
+  return s > 8.0 * tolerance && s < r ? s : -1.0;
+}
+
+// MergeTwinSheets' second rule, for the probed points (`probed`, unit gradients `dir`, probe values pd, pg) that
+// found no twin (`best` empty): where a side's near (else middle) probe shows a kink before it (KinkBeforeProbe), one more
+// value halfway to the kink measures the rise a_p (within [0.5, 1.5], and a_p - slope >= 0.7: a kink, not a
+// bend), and the point goes to the kink, nearer side first, appended to moved / target.
+void KinksWithoutTwins(const Udf& udf, const std::vector<Vec3>& points, const std::vector<size_t>& probed,
+                       const std::vector<Vec3>& dir, const std::vector<double>& pd, const std::vector<Vec3>& pg,
+                       const std::vector<size_t>& best, double tolerance, double within, std::vector<size_t>& moved,
+                       std::vector<Vec3>& target, std::vector<double>& top) {
+  struct Kink { size_t k; Vec3 v; double s, slope, reach, r; };  // reach: the probe's line at 0, f - slope r
+  std::vector<Kink> kinks;
+  std::vector<Vec3> halfway;
+  for (size_t k = 0; k < probed.size(); ++k) {
+    if (best[k] != SIZE_MAX) continue;
+    for (int side = 0; side < 2; ++side) {
+      const Vec3 v = side == 0 ? dir[k] : Vec3(-dir[k]);
+      // The near probe, or where the kink lies beyond it (|e| up to within / 2.5), the middle one.
+      for (size_t scale = 0; scale < 2; ++scale) {
+        const size_t j = (kScales.size() * k + scale) * 2 + static_cast<size_t>(side);
+        const double r = kScales[scale] * within;
+        const double slope = pg[j].dot(v), s = KinkBeforeProbe(pd[j], slope, r, tolerance);
+        if (s < 0.0) continue;
+        kinks.push_back({k, v, s, slope, pd[j] - slope * r, r});
+        halfway.push_back(points[probed[k]] + 0.5 * s * v);
+        break;
+      }
+    }
+  }
+  if (kinks.empty()) return;
+  std::vector<double> d;
+  std::vector<Vec3> g;
+  udf.Evaluate(halfway, d, g);
+  std::vector<size_t> chosen(probed.size(), SIZE_MAX);
+  std::vector<double> at(kinks.size(), -1.0);
+  for (size_t c = 0; c < kinks.size(); ++c) {
+    const Kink& kink = kinks[c];
+    const double a_p = d[c] / (0.5 * kink.s);
+    if (!(a_p >= 0.5 && a_p <= 1.5 && a_p - kink.slope >= 0.7)) continue;
+    at[c] = kink.reach / (a_p - kink.slope);  // where the rise a_p meets the probe's line
+    if (!(at[c] > 8.0 * tolerance && at[c] < kink.r)) continue;
+    size_t& b = chosen[kink.k];
+    if (b == SIZE_MAX || at[c] < at[b]) b = c;
+  }
+  for (size_t k = 0; k < probed.size(); ++k)
+    if (chosen[k] != SIZE_MAX) {
+      const Kink& kink = kinks[chosen[k]];
+      moved.push_back(probed[k]);
+      target.push_back(points[probed[k]] + at[chosen[k]] * kink.v);
+      top.push_back(d[chosen[k]] / (0.5 * kink.s) * at[chosen[k]]);  // the rise a_p over the kink's distance
+    }
+}
+
+}  // namespace
+
 void MergeTwinSheets(const Udf& udf, std::vector<Vec3>& points, ProjectionResult& result, double tolerance,
                      double within) {
-  // Probes at three distances: a tilted gradient reads a probe short by r (1 - cos tilt), so a probe at r
-  // tells twins apart only beyond 0.13 r; the near ones find the close twins, the far one the rest.
-  static constexpr std::array<double, 3> kScales = {0.25, 0.5, 1.0};
   std::vector<size_t> probed;
   std::vector<Vec3> probes, dir;
   for (size_t i = 0; i < points.size(); ++i) {
@@ -57,15 +123,16 @@ void MergeTwinSheets(const Udf& udf, std::vector<Vec3>& points, ProjectionResult
     }
   }
   if (probed.empty()) return;
-  std::vector<double> d;
-  std::vector<Vec3> g;
-  udf.Evaluate(probes, d, g);
-  // A probe counts when it read less than within cos 30° with its gradient within 45° of its own direction.
+  std::vector<double> pd, d;
+  std::vector<Vec3> pg, g;
+  udf.Evaluate(probes, pd, pg);
+  // A probe counts when it read less than within cos 30° with its gradient within 60° of its own direction (near
+  // an edge the line crosses the twin sheet obliquely).
   // Every such probe is a candidate, not just the nearest: where the error varies along the normal the field
   // rises slower than 1 on one side, and a probe there passes the test although no twin lies beyond it; its
   // projection comes back to the point itself. So each candidate's twin is found and checked, and the nearest
   // one that checks out wins.
-  const double passed = std::cos(M_PI / 6.0), onward = std::cos(M_PI / 4.0);
+  const double passed = std::cos(M_PI / 6.0), onward = std::cos(M_PI / 3.0);
   std::vector<size_t> owner;  // per candidate: index into probed
   std::vector<Vec3> twin_at;  // per candidate: its probe, then the twin it projects to
   for (size_t k = 0; k < probed.size(); ++k)
@@ -74,11 +141,10 @@ void MergeTwinSheets(const Udf& udf, std::vector<Vec3>& points, ProjectionResult
         const size_t j = (kScales.size() * k + scale) * 2 + static_cast<size_t>(side);
         const double r = kScales[scale] * within;
         const Vec3 v = side == 0 ? dir[k] : Vec3(-dir[k]);
-        if (!std::isfinite(d[j]) || !(d[j] < passed * r) || g[j].dot(v) < onward * g[j].norm()) continue;
+        if (!std::isfinite(pd[j]) || !(pd[j] < passed * r) || pg[j].dot(v) < onward * pg[j].norm()) continue;
         owner.push_back(k);
         twin_at.push_back(probes[j]);
       }
-  if (owner.empty()) return;
   // The twin itself, from that probe: where its own error puts it, not where the probe's error said.
   ProjectionOptions to_twin;
   to_twin.tolerance = tolerance;
@@ -102,7 +168,7 @@ void MergeTwinSheets(const Udf& udf, std::vector<Vec3>& points, ProjectionResult
   // 1 -+ the error's own slope along the line. The quarter points measure both slopes a_p, a_t; where both are
   // within [0.5, 1.5] it is a ridge, and its top, where the two lines meet, is at s = a_t t / (a_p + a_t) from
   // the point: the surface itself for an error linear along the line (the midpoint is off by e's slope x t/2).
-  udf.Evaluate(quarters, d, g);
+  if (!quarters.empty()) udf.Evaluate(quarters, d, g);
   std::vector<Vec3> ridge(owner.size());
   std::vector<size_t> best(probed.size(), SIZE_MAX);
   for (size_t c = 0; c < owner.size(); ++c) {
@@ -117,11 +183,15 @@ void MergeTwinSheets(const Udf& udf, std::vector<Vec3>& points, ProjectionResult
   }
   std::vector<size_t> moved;
   std::vector<Vec3> target;
+  std::vector<double> top;  // the value a kink's top should read (NaN: a twin's ridge)
   for (size_t k = 0; k < probed.size(); ++k)
-    if (best[k] != SIZE_MAX) moved.push_back(probed[k]), target.push_back(ridge[best[k]]);
+    if (best[k] != SIZE_MAX) moved.push_back(probed[k]), target.push_back(ridge[best[k]]), top.push_back(NAN);
+  KinksWithoutTwins(udf, points, probed, dir, pd, pg, best, tolerance, within, moved, target, top);
   if (moved.empty()) return;
   udf.Evaluate(target, d, g);
   for (size_t k = 0; k < moved.size(); ++k) {
+    // A kink's top reads what the rise predicts; a level stretch (the field clipped) reads less: no kink.
+    if (std::isfinite(top[k]) && !(d[k] >= 0.75 * top[k] && d[k] <= 1.25 * top[k])) continue;
     points[moved[k]] = target[k];
     result.distance[moved[k]] = d[k];
     result.gradient[moved[k]] = g[k];

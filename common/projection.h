@@ -83,15 +83,20 @@ double EstimateTwinWithin(const ProjectionResult& result, double tolerance, doub
 /// Where a field's zero set is a surface doubled by an error (|d + e| with e < 0: zeros at d = |e| either
 /// side, a ridge of height |e| on the surface between them), moves each converged point that lies on a zero
 /// sheet to the ridge: it probes x +- r u at r = within/4, within/2 and within (u: the unit gradient there);
-/// a probe that has passed a twin sheet reads d < r cos 30° with its gradient pointing on along the probe (a
-/// single sheet reads about r, a sheet across the probe gives a gradient across it). From every such probe a
+/// a probe that has passed a twin sheet reads d < r cos 30° with its gradient within 60° of the probe's direction
+/// (a single sheet reads about r, a sheet along the probe gives a gradient across it). From every such probe a
 /// twin is found by projection (where the error varies along the normal the field rises slower than 1 on one
 /// side, and a probe there passes although its projection comes back to the point's own sheet). Between a
 /// point and its twin, t apart, the field rises from each sheet to a kink on the surface; the quarter points
 /// measure the two slopes, and where both lie in [0.5, 1.5] (a ridge) the point moves to the ridge's top, where
 /// the two lines meet: the surface itself when the error is linear along the line. The nearest such twin more
-/// than 8 tolerances and less than `within` away wins. Six evaluations per point probed, and a few more per
-/// candidate twin; `result` gets the new positions' values and gradients and counts them in num_merged. Sheets
+/// than 8 tolerances and less than `within` away wins. A point with no such twin still has its ridge where the
+/// twins curve round an edge: along a line from the cylinder round a convex edge the field rises at 1 to the edge
+/// and then falls slower than 0.5 (or stays level, along a face) towards a twin that may lie beyond `within`. So
+/// where the near probe (else the middle one) reads less than r cos 30° with the field's slope along the line at
+/// most 0.3 there, the kink is where the rise from the point (measured halfway to it, in [0.5, 1.5]) meets the
+/// line through the probe at that slope, and the point moves to it when that is nearer than the probe (the
+/// slopes differing by at least 0.7) if the field there reads that rise within 25 % (not a level stretch). Six evaluations per point probed, and a few more per candidate twin; `result` gets the new positions' values and gradients and counts them in num_merged. Sheets
 /// closer than `within` that are really there (a wall thinner than the field's error) become one surface.
 /// The stages' log line for a projection that merged twin sheets: "the field has a floor: ...", naming the
 /// separation (absolute and x `diagonal`) and how many `what` (seeds, samples) moved.

@@ -274,6 +274,63 @@ TEST(Projection, TwinSheetsWhoseErrorVariesAlongTheNormalGoToTheRidgeFromBothSid
   EXPECT_GT(below, 100u);
 }
 
+// |d - a| for d the distance to the boundary of the quarter space x <= 0, y <= 0 (a convex 90° edge on the z
+// axis): twin sheets a off each face, joined outside the edge by a cylinder of radius a around it.
+class EdgeWithTwins final : public Udf {
+ public:
+  explicit EdgeWithTwins(double a) : a_(a) {}
+  void EvaluateChunk(const Vec3* p, size_t count, double* d, Vec3* g) const override {
+    for (size_t i = 0; i < count; ++i) {
+      const double x = p[i].x(), y = p[i].y();
+      double dist;
+      Vec3 grad;
+      if (x >= 0 && y >= 0) {
+        dist = std::hypot(x, y);
+        grad = dist > 0 ? Vec3(x / dist, y / dist, 0) : Vec3(1, 0, 0);
+      } else if (x >= 0 || y >= 0) {
+        dist = x >= 0 ? x : y;
+        grad = x >= 0 ? Vec3(1, 0, 0) : Vec3(0, 1, 0);
+      } else {
+        dist = std::min(-x, -y);
+        grad = -x < -y ? Vec3(-1, 0, 0) : Vec3(0, -1, 0);
+      }
+      d[i] = std::abs(dist - a_);
+      g[i] = (dist < a_ ? -1.0 : 1.0) * grad;
+    }
+  }
+  Box Domain() const override { return {Vec3::Constant(-1), Vec3::Constant(1)}; }
+  std::string Describe() const override { return "edge with twins"; }
+
+ private:
+  double a_;
+};
+
+// A point on the cylinder has no twin along its gradient unless it lies within 15° of the bisector: beyond
+// the edge the line runs into the solid at sin(45° - φ) from the nearer face, a slope below 0.5, or along a
+// face. The ridge's top along the line is still the edge, where the field stops rising at 1.
+TEST(Projection, TwinSheetsRoundAnEdgeGoToTheEdge) {
+  const double a = 2e-3;
+  const EdgeWithTwins udf(a);
+  Rng rng(11, 0);
+  std::vector<Vec3> start;
+  for (int k = 0; k < 200; ++k) {
+    const double phi = rng.Uniform(2.0, 88.0) * M_PI / 180.0, r = rng.Uniform(1.2, 2.0) * a;
+    start.emplace_back(r * std::cos(phi), r * std::sin(phi), rng.Uniform(-0.5, 0.5));
+  }
+  ProjectionOptions options;
+  options.tolerance = 1e-9;
+  options.floor_tolerance = 1e-2;
+  options.twin_within = 5.0 * a;
+  std::vector<Vec3> points = start;
+  const ProjectionResult r = ProjectToZeroSet(udf, points, options, Monitor::Null());
+  EXPECT_EQ(r.num_converged, start.size());
+  EXPECT_EQ(r.num_merged, start.size());
+  for (size_t i = 0; i < points.size(); ++i) {
+    EXPECT_LT(std::hypot(points[i].x(), points[i].y()), 0.02 * a) << "point " << i << " started at " << start[i].transpose();
+    EXPECT_NEAR(points[i].z(), start[i].z(), 1e-12);
+  }
+}
+
 TEST(Projection, AnExactFieldsThinWallIsNotMergedForItHasNoFloor) {
   const double a = 2e-3;
   const FloorAndTwins udf(a, false);  // two real sheets 2a apart, no floor anywhere
