@@ -114,6 +114,52 @@ TEST(FittedSamplePlanes, TheValueErrorsTiltIsTheirSlopeAlongTheSurface) {
   EXPECT_FALSE(FitPaysOff(0.10, 0.0, 8 * M_PI / 180));   // 5.7°: below the floor
 }
 
+// PlaneCell's samples seen through |d + e| with a constant e: for e < 0 zero sheets at z = +-|e| (samples
+// between them point at the nearer one), for e > 0 a floor whose foot points overshoot the plane by e.
+CellSamples ShiftedPlaneCell(double e, uint64_t seed) {
+  CellSamples cells = PlaneCell(0.0, 100, 0.1, seed);
+  for (size_t k = 0; k < cells.point.size(); ++k) {
+    const double z = cells.point[k].z(), side = z < 0 ? -1.0 : 1.0;
+    cells.distance[k] = std::abs(std::abs(z) + e);
+    cells.gradient[k] = Vec3(0, 0, std::abs(z) + e < 0 ? -side : side);
+  }
+  return cells;
+}
+
+// The plane of sample k passes through z = 0: n_z (p_z - 0) = distance.
+double OffThePlane(const CellSamples& cells, size_t k) {
+  return cells.gradient[k].dot(cells.point[k]) - cells.distance[k];
+}
+
+TEST(FittedSamplePlanes, TwinsAndFloorsAreCentredOnTheSurface) {
+  for (double e : {-2e-3, 3e-3}) {
+    CellSamples cells = ShiftedPlaneCell(e, 8);
+    size_t off = 0, between = 0;
+    for (size_t k = 0; k < cells.point.size(); ++k) {
+      off += std::abs(OffThePlane(cells, k)) > 0.5 * std::abs(e);
+      between += std::abs(cells.point[k].z()) < -e;
+    }
+    EXPECT_GT(off, 90u) << "e " << e;  // each side's planes |e| off the surface
+    if (e < 0) {
+      EXPECT_GT(between, 0u);
+    }
+    CenterTwinPlanes(cells, 5 * std::abs(e), 1e-9);
+    for (size_t k = 0; k < cells.point.size(); ++k)
+      EXPECT_NEAR(OffThePlane(cells, k), 0.0, 1e-12) << "e " << e << ", sample " << k << " at " << cells.point[k].transpose();
+  }
+}
+
+TEST(FittedSamplePlanes, SheetsFartherApartThanTheTwinsAreLeftAsTheyAre) {
+  const CellSamples wall = ShiftedPlaneCell(-2e-3, 9);  // sheets 4e-3 apart
+  CellSamples cells = wall;
+  CenterTwinPlanes(cells, 3e-3, 1e-9);
+  EXPECT_EQ(cells.distance, wall.distance);
+  const CellSamples exact = PlaneCell(0.0, 100, 0.1, 9);
+  cells = exact;
+  CenterTwinPlanes(cells, 3e-3, 1e-9);
+  EXPECT_EQ(cells.distance, exact.distance);
+}
+
 TEST(FittedSamplePlanes, ExactGradientsOnAPlaneAreLeftAsTheyAre) {
   const CellSamples exact = PlaneCell(0.0, 100, 0.1, 4);
   CellSamples cells = exact;

@@ -13,20 +13,30 @@
 namespace voroudf {
 namespace {
 
+// A cell's samples [begin, end): their foot points p - d g, unit gradients, and whether they have a plane.
+struct Feet {
+  std::vector<Vec3> foot, unit;
+  std::vector<char> usable;
+  Feet(const CellSamples& cells, size_t begin, size_t end) : foot(end - begin), unit(end - begin), usable(end - begin) {
+    for (size_t a = 0; a < end - begin; ++a) {
+      const Vec3& g = cells.gradient[begin + a];
+      usable[a] = g.squaredNorm() >= 0.25 && std::isfinite(cells.distance[begin + a]);
+      unit[a] = usable[a] ? Vec3(g.normalized()) : Vec3::Zero();
+      foot[a] = cells.point[begin + a] - cells.distance[begin + a] * g;
+    }
+  }
+};
+
 // Fits the planes of one cell's samples [begin, end) into normal/offset (unchanged where too few agree);
 // appends each fitted sample's angle to its gradient. Brute force over the cell's ≤ M samples: M² distance
 // tests per cell are cheaper than building a tree for 100 points.
 void FitCell(const CellSamples& cells, size_t begin, size_t end, const SamplePlaneFit& fit,
              std::vector<Vec3>& normal, std::vector<double>& distance, std::vector<double>& angles) {
   const size_t m = end - begin;
-  std::vector<Vec3> foot(m), unit(m);
-  std::vector<char> usable(m);
-  for (size_t a = 0; a < m; ++a) {
-    const Vec3& g = cells.gradient[begin + a];
-    usable[a] = g.squaredNorm() >= 0.25 && std::isfinite(cells.distance[begin + a]);
-    unit[a] = usable[a] ? Vec3(g.normalized()) : Vec3::Zero();
-    foot[a] = cells.point[begin + a] - cells.distance[begin + a] * g;
-  }
+  const Feet feet(cells, begin, end);
+  const std::vector<Vec3>& foot = feet.foot;
+  const std::vector<Vec3>& unit = feet.unit;
+  const std::vector<char>& usable = feet.usable;
   const double agree = std::cos(fit.agree_deg * M_PI / 180.0);
   const size_t k_max = static_cast<size_t>(fit.neighbours);
   std::vector<double> best_d(k_max);
@@ -122,6 +132,40 @@ SamplePlanes FitSamplePlanes(const CellSamples& cells, const SamplePlaneFit& fit
   for (const auto& a : angles) all.insert(all.end(), a.begin(), a.end());
   planes.median_angle = Median(all);
   return planes;
+}
+
+void CenterTwinPlanes(CellSamples& cells, double within, double tolerance) {
+  const long n = static_cast<long>(cells.sample_offset.size()) - 1;
+  const double other_side = -std::cos(50.0 * M_PI / 180.0);
+  std::vector<double> centred = cells.distance;
+#pragma omp parallel for schedule(dynamic, 16)
+  for (long i = 0; i < n; ++i) {
+    const size_t begin = cells.sample_offset[static_cast<size_t>(i)], end = cells.sample_offset[static_cast<size_t>(i) + 1];
+    const size_t m = end - begin;
+    const Feet feet(cells, begin, end);
+    const std::vector<Vec3>& foot = feet.foot;
+    const std::vector<Vec3>& unit = feet.unit;
+    const std::vector<char>& usable = feet.usable;
+    // Brute force over the cell's <= M samples, as in FitCell.
+    for (size_t a = 0; a < m; ++a) {
+      if (!usable[a]) continue;
+      size_t best = SIZE_MAX;
+      double best_d2 = INFINITY;
+      for (size_t b = 0; b < m; ++b) {
+        if (!usable[b] || unit[a].dot(unit[b]) > other_side) continue;
+        // A sample between the twins points at the same sheet as the other side's samples there (gap 0).
+        const Vec3 delta = foot[a] - foot[b];
+        const double along = unit[a].dot(delta);
+        if (std::abs(along) <= 8.0 * tolerance) continue;
+        const double lateral2 = delta.squaredNorm() - along * along;
+        if (lateral2 < best_d2) best_d2 = lateral2, best = b;
+      }
+      if (best == SIZE_MAX) continue;
+      const double gap = unit[a].dot(foot[a] - foot[best]);
+      if (std::abs(gap) < within) centred[begin + a] += 0.5 * gap;
+    }
+  }
+  cells.distance.swap(centred);
 }
 
 void UseSamplePlanes(CellSamples& cells, SamplePlanes& planes) {

@@ -44,6 +44,20 @@ SamplePlanes FitSamplePlanes(const CellSamples& cells, const SamplePlaneFit& fit
 /// The cells' gradients and values become `planes`' normals and distances (swapped in).
 void UseSamplePlanes(CellSamples& cells, SamplePlanes& planes);
 
+/// Where a value error doubles the zero set (|d + e|: sheets |e| either side of the surface where e < 0; where
+/// e > 0 the foot points overshoot the surface by e), every sample's plane is off the surface by -e along its
+/// own normal, on its own side, and the samples of the two sides give two families of planes 2|e| apart: the L1
+/// energy is level between them, so a seed stays wherever it is inside that slab (a curve seed up to |e| /
+/// sin(half the dihedral) along a face from its edge). Each sample's plane moves halfway to the foot point of
+/// the other side's sample (gradient more than 130° from its own) nearest its normal line, gap = n̂ᵀ(f_m −
+/// f_other): distance += gap / 2, the mid-surface of the twins, where |gap| < `within` (the projection's twin
+/// separation; farther, they are two surfaces). Foot points within 8 `tolerance` of the sample's own plane are
+/// not the other side's: a sample between the twins points at the same sheet as the samples beyond it. Cells
+/// whose samples all face one way keep their planes. Only for fields with floors (within > 0): an exact
+/// field's two sides give the same planes.
+/// \pre within > 0
+void CenterTwinPlanes(CellSamples& cells, double within, double tolerance);
+
 /// How far a field's value errors tilt its zero set (radians), from the values `floor` at `points` where a
 /// projection stopped at a floor or ridge (|d + e| = |e| there, common/projection.h): atan(s / cos 45°), s
 /// the median over the points of |Δ floor| / |Δ x| to the nearest other such point (a slope along a random
