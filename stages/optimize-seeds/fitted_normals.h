@@ -53,8 +53,9 @@ void UseSamplePlanes(CellSamples& cells, SamplePlanes& planes);
 /// f_other): distance += gap / 2, the mid-surface of the twins, where |gap| < `within` (the projection's twin
 /// separation; farther, they are two surfaces). Foot points within 8 `tolerance` of the sample's own plane are
 /// not the other side's: a sample between the twins points at the same sheet as the samples beyond it. Cells
-/// whose samples all face one way keep their planes. Only for fields with floors (within > 0): an exact
-/// field's two sides give the same planes.
+/// whose samples all face one way keep their planes. Only for fields whose projection merges twins (the
+/// caller's test): an exact field's two sides give the same planes, and where a field's floors come without
+/// twins (a grid's rounded valleys) the foot points are off near the surface only, not by -e for every sample.
 /// \pre within > 0
 void CenterTwinPlanes(CellSamples& cells, double within, double tolerance);
 

@@ -105,10 +105,11 @@ void CountRanks(const SeedState& s, OuterIterationReport& report) {
 }
 
 // Input seeds on the zero set, in input order, without exact duplicates (their repulsion has no direction);
-// *twin_within: the twin separation their projection measured (common/projection.h); *value_tilt: how far
+// *twin_within: the twin separation their projection measured (common/projection.h), *twins_seen: whether it
+// moved at least kTwinMinFloorShare of them to a ridge between twin sheets; *value_tilt: how far
 // the field's value errors tilt its zero set, from the seeds that stopped at a floor or ridge (ValueErrorTilt).
 SeedState Prepare(const Udf& udf, const SeedCloud& input, const ProjectionOptions& projection, Monitor& monitor,
-                  double* twin_within, double* value_tilt) {
+                  double* twin_within, bool* twins_seen, double* value_tilt) {
   if (input.size() < 2)
     throw InputError("input seeds", "has " + std::to_string(input.size()) + " seed(s); optimize-seeds needs at least 2");
   std::vector<size_t> order(input.size());
@@ -131,6 +132,7 @@ SeedState Prepare(const Udf& udf, const SeedCloud& input, const ProjectionOption
   ProjectionResult r = ProjectToZeroSet(udf, points, projection, monitor);
   SeedState s;
   *twin_within = r.twin_within;
+  *twins_seen = static_cast<double>(r.num_merged) >= kTwinMinFloorShare * static_cast<double>(r.num_converged);
   if (r.twin_within > 0.0)
     monitor.Info(TwinSheetsSummary(r, udf.Domain().Diagonal(), "seeds"));
   std::vector<Vec3> at_floor;
@@ -316,8 +318,9 @@ SeedCloud OptimizeSeeds(const Udf& udf, const SeedCloud& input, const OptimizeSe
   const auto start = Clock::now();
   Optimizer opt(udf, options, monitor);
   double twin_within = 0.0, value_tilt = 0.0;
-  SeedState s = Prepare(udf, input, opt.projection(), monitor, &twin_within, &value_tilt);
-  opt.SetTwinWithin(twin_within);
+  bool twins_seen = false;
+  SeedState s = Prepare(udf, input, opt.projection(), monitor, &twin_within, &twins_seen, &value_tilt);
+  opt.SetTwinWithin(twin_within, twins_seen);
   opt.SetValueErrorTilt(value_tilt);
   const size_t n = s.position.size();
   const auto [spacing_in, cv_in] = opt.SpacingStats(s.position);

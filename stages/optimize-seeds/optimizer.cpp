@@ -114,7 +114,7 @@ CellSamples Optimizer::Analyze(SeedState& s, bool early) {
     if (fit_planes_ > 0) UseSamplePlanes(cells, planes);
     monitor_.Debug(Format("sample planes: gradients %.2f deg off (median)", gradient_error_ * 180.0 / M_PI));
   }
-  if (projection_.twin_within > 0.0) CenterTwinPlanes(cells, projection_.twin_within, projection_.tolerance);
+  if (centre_twin_planes_) CenterTwinPlanes(cells, projection_.twin_within, projection_.tolerance);
   const long n = static_cast<long>(s.position.size());
   std::vector<TangentRank> ranks(static_cast<size_t>(n));
 #pragma omp parallel for schedule(static)

@@ -119,8 +119,12 @@ class Optimizer {
   double last_acceptance() const { return last_acceptance_; }
   double normal_spread() const { return normal_spread_; }
   const ProjectionOptions& projection() const { return projection_; }
-  /// Every later projection takes zero sheets closer than this for one (Prepare measures it).
-  void SetTwinWithin(double within) { projection_.twin_within = within; }
+  /// Every later projection takes zero sheets closer than this for one (Prepare measures it); where the field
+  /// shows twins (`centre`), the sample planes are centred between them (CenterTwinPlanes).
+  void SetTwinWithin(double within, bool centre) {
+    projection_.twin_within = within;
+    centre_twin_planes_ = centre && within > 0.0;
+  }
   /// --sample-planes auto fits only where the gradients are off by more than this explains (ValueErrorTilt).
   void SetValueErrorTilt(double radians) { value_tilt_ = radians; }
 
@@ -141,11 +145,12 @@ class Optimizer {
   double crease_angle_ = options_.crease_angle_deg * M_PI / 180.0;
   double crease_max_angle_ = BlindCreaseAngle(options_.rank_threshold);
   double crease_share_ = SecondPlaneShare(options_.rank_threshold);
-  double normal_spread_ = 0.0;
+  double normal_spread_ = 0.0;  ///< the last Analyze's UnexplainedNormalSpread (0 with --rank-noise off)
   // --sample-planes: 1 fit, 0 gradient, -1 auto (undecided until the first cells are measured).
   int fit_planes_ = options_.sample_planes == "fit" ? 1 : options_.sample_planes == "auto" ? -1 : 0;
   double gradient_error_ = 0.0;  ///< radians, the last measured median (FitSamplePlanes)
-  double value_tilt_ = 0.0;      ///< radians (SetValueErrorTilt)  ///< the last Analyze's UnexplainedNormalSpread (0 with --rank-noise off)
+  double value_tilt_ = 0.0;      ///< radians (SetValueErrorTilt)
+  bool centre_twin_planes_ = false;  ///< SetTwinWithin
 };
 
 }  // namespace voroudf
