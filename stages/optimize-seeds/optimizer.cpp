@@ -15,7 +15,28 @@ constexpr double kCreaseContrast = 6.0;
 
 double Optimizer::Project(SeedState& s, const std::vector<Vec3>& previous, std::vector<Vec3> moved, double min_separation) {
   const size_t n = moved.size();
+  const std::vector<Vec3> targets = moved;
   ProjectionResult r = ProjectToZeroSet(udf_, moved, projection_, Monitor::Null());
+  // Where the field shows twins, a curve or corner seed's target is where the centred planes cross: the edge as
+  // both sides of the field see it. Projecting it puts it on a twin sheet |e| out (the cylinder round the edge),
+  // from where the twin merge along a gradient that an error tilts may not come back. So such a seed whose
+  // target reads at most the largest error the floors show (0.4 x the twin separation: between the twins)
+  // stays at its target.
+  if (centre_twin_planes_) {
+    std::vector<size_t> idx;
+    std::vector<Vec3> at;
+    for (size_t i = 0; i < n && i < s.rank.size(); ++i)
+      if (s.rank[i].rank >= 2 && r.converged[i]) idx.push_back(i), at.push_back(targets[i]);
+    std::vector<double> d;
+    std::vector<Vec3> g;
+    if (!at.empty()) udf_.Evaluate(at, d, g);
+    for (size_t k = 0; k < idx.size(); ++k)
+      if (d[k] <= 0.4 * projection_.twin_within) {
+        moved[idx[k]] = at[k];
+        r.distance[idx[k]] = d[k];
+        r.gradient[idx[k]] = g[k];
+      }
+  }
   std::vector<char> accept(r.converged);
   const size_t failed = n - r.num_converged;
   std::vector<double> floor(n, min_separation);
