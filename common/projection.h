@@ -93,10 +93,12 @@ double EstimateTwinWithin(const ProjectionResult& result, double tolerance, doub
 /// than 8 tolerances and less than `within` away wins. A point with no such twin still has its ridge where the
 /// twins curve round an edge: along a line from the cylinder round a convex edge the field rises at 1 to the edge
 /// and then falls slower than 0.5 (or stays level, along a face) towards a twin that may lie beyond `within`. So
-/// where the near probe reads less than r cos 30° with the field's slope along the line in
-/// [-0.75, 0.3] there (a fall at about 1 is a ridge between two sheets, left to the twin rule), the kink is where the rise from the point (measured halfway to it, in [0.5, 1.5]) meets the
-/// line through the probe at that slope, and the point moves to it when that is nearer than the probe (the
-/// slopes differing by at least 0.7) if the field there reads that rise within 25 % (not a level stretch). Six evaluations per point probed, and a few more per candidate twin; `result` gets the new positions' values and gradients and counts them in num_merged. Sheets
+/// where the near probe reads less than r cos 30° with the field's slope along the line in [-0.75, 0.3] there (a
+/// fall at about 1 is a ridge between two sheets, left to the twin rule), the kink is where the rise from the
+/// point (measured halfway to it, in [0.5, 1.5]) meets the line through the probe at that slope, and the point
+/// moves to it when that is nearer than the probe (the slopes differing by at least 0.7) if the field there reads
+/// that rise within 25 % (not a level stretch). Six evaluations per point probed, and a few more per candidate
+/// twin or kink; `result` gets the new positions' values and gradients and counts them in num_merged. Sheets
 /// closer than `within` that are really there (a wall thinner than the field's error) become one surface.
 /// The stages' log line for a projection that merged twin sheets: "the field has a floor: ...", naming the
 /// separation (absolute and x `diagonal`) and how many `what` (seeds, samples) moved.

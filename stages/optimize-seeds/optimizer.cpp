@@ -15,7 +15,8 @@ constexpr double kCreaseContrast = 6.0;
 
 double Optimizer::Project(SeedState& s, const std::vector<Vec3>& previous, std::vector<Vec3> moved, double min_separation) {
   const size_t n = moved.size();
-  const std::vector<Vec3> targets = moved;
+  std::vector<Vec3> targets;  // kept for the rule below only
+  if (centre_twin_planes_) targets = moved;
   ProjectionResult r = ProjectToZeroSet(udf_, moved, projection_, Monitor::Null());
   // Where the field shows twins, a curve or corner seed's target is where the centred planes cross: the edge as
   // both sides of the field see it. Projecting it puts it on a twin sheet |e| out (the cylinder round the edge),
