@@ -1167,6 +1167,69 @@ TEST(OptimizeSeeds, SheetSeedsBetweenTwoCurveSeedsAreDropped) {
   EXPECT_EQ(SeedsBesideFeatures(position, rank, 0.02, {}, along), (std::vector<char>{0, 0, 1, 0, 0, 1}));
 }
 
+// Two curve seeds lie on one curve when their chord bisects their tangents (a circular arc's chords do, at
+// any length), on two when it leaves the bisector: two parallel edges of a strip.
+TEST(OptimizeSeeds, ChordsOffTheTangentsBisectorJoinTwoCurves) {
+  const Vec3 x = Vec3::UnitX(), y = Vec3::UnitY();
+  for (double angle : {0.2, 0.5, 1.0}) {  // on the unit circle: one curve, whatever the separation asked
+    const Vec3 b(std::cos(angle), std::sin(angle), 0), t_b(-std::sin(angle), std::cos(angle), 0);
+    EXPECT_FALSE(OnTwoCurves(Vec3(1, 0, 0), y, b, t_b, 1e-6)) << angle;
+  }
+  // Parallel lines 0.1 apart: the seed across at 0.3 along is 18° off the tangents, at 1.0 along 6°.
+  EXPECT_TRUE(OnTwoCurves(Vec3::Zero(), x, Vec3(0.3, 0.1, 0), -x, 0.09));
+  EXPECT_FALSE(OnTwoCurves(Vec3::Zero(), x, Vec3(0.3, 0.1, 0), x, 0.11)) << "closer than the separation asked";
+  EXPECT_FALSE(OnTwoCurves(Vec3::Zero(), x, Vec3(1.0, 0.1, 0), x, 0.05));
+  EXPECT_FALSE(OnTwoCurves(Vec3::Zero(), x, Vec3(0.3, 0.1, 0), Vec3::Zero(), 0.05)) << "no tangent";
+  EXPECT_FALSE(OnTwoCurves(Vec3::Zero(), x, Vec3(0.3, 0.1, 0), x, 0.0)) << "off";
+  // The feature-seed thinning keeps both rims' seeds with a separation, one of them without.
+  const std::vector<Vec3> position = {{0, 0, 0}, {0.01, 0.015, 0}};
+  const std::vector<uint8_t> rank = {2, 2};
+  EXPECT_EQ(SeedsBesideFeatures(position, rank, 0.03, {}, {x, x}, 0.01), (std::vector<char>{0, 0}));
+  EXPECT_EQ(SeedsBesideFeatures(position, rank, 0.03, {}, {x, x}, 0.0), (std::vector<char>{0, 1}));
+}
+
+// A plate whose edge faces are half a spacing wide: each of its 8 long rims gets its own chain of curve
+// seeds (no gap over 2.5 spacings). Without the two-curve rule the rims of one edge face crowd each other
+// out and share one chain, with gaps of several spacings on each.
+std::unique_ptr<MeshUdf> SlabUdf(double thickness) {
+  TriangleMesh m;
+  m.vertices = {Vec3(-1, -1, 0), Vec3(1, -1, 0), Vec3(1, 1, 0), Vec3(-1, 1, 0),
+                Vec3(-1, -1, thickness), Vec3(1, -1, thickness), Vec3(1, 1, thickness), Vec3(-1, 1, thickness)};
+  m.faces = {{0, 2, 1}, {0, 3, 2}, {4, 5, 6}, {4, 6, 7}, {0, 1, 5}, {0, 5, 4},
+             {1, 2, 6}, {1, 6, 5}, {2, 3, 7}, {2, 7, 6}, {3, 0, 4}, {3, 4, 7}};
+  return std::make_unique<MeshUdf>(m, "slab");
+}
+
+TEST(OptimizeSeeds, BothRimsOfANarrowEdgeFaceGetAChain) {
+  const double thickness = 0.03;
+  const auto udf = SlabUdf(thickness);
+  const SeedCloud in = Initial(*udf, 800, 1);
+  auto widest_gap = [&](double curve_separation) {
+    OptimizeSeedsOptions options;
+    options.curve_separation = curve_separation;
+    const SeedCloud out = OptimizeSeeds(*udf, in, options, Monitor::Null());
+    double spacing = 0.0;
+    NearestNeighbourCv(out.position, &spacing);
+    EXPECT_GT(thickness, 0.45 * spacing) << "the edge faces must be wide enough for two chains";
+    double widest = 0.0;
+    for (int axis = 0; axis < 2; ++axis)  // rims along x (at y = ±1) and along y (at x = ±1)
+      for (double side : {-1.0, 1.0})
+        for (double z : {0.0, thickness}) {
+          std::vector<double> along = {-1.0, 1.0};
+          for (size_t i = 0; i < out.size(); ++i) {
+            const Vec3& p = out.position[i];
+            if (out.rank[i] >= 2 && std::abs(p[1 - axis] - side) < 0.05 * spacing && std::abs(p.z() - z) < 0.05 * spacing)
+              along.push_back(p[axis]);
+          }
+          std::sort(along.begin(), along.end());
+          for (size_t k = 1; k < along.size(); ++k) widest = std::max(widest, (along[k] - along[k - 1]) / spacing);
+        }
+    return widest;
+  };
+  EXPECT_LT(widest_gap(0.45), 2.5);
+  EXPECT_GT(widest_gap(0.0), 4.0) << "the test needs rims that share a chain without the rule";
+}
+
 // The stopping rules fire before the caps: the inner loop at the first round whose projected gradient
 // does not decrease by δ, the outer loop at the first iteration where σ stops growing and the spacing
 // CV improves by less than outer_tol (and not before it).

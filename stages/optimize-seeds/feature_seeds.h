@@ -41,7 +41,9 @@ struct FeatureLinks {
   std::vector<std::pair<int, Vec3>> ends;
 };
 
-FeatureLinks FindFeatureLinks(const SeedState& s, const std::vector<Vec3>& tangent, double radius);
+/// `curve_separation`: seeds on two curves (OnTwoCurves) are never linked.
+FeatureLinks FindFeatureLinks(const SeedState& s, const std::vector<Vec3>& tangent, double radius,
+                              double curve_separation);
 
 /// Removes the seeds marked in `drop` from every array of the state, keeping the others' order.
 void EraseSeeds(SeedState& s, const std::vector<char>& drop);
@@ -62,7 +64,7 @@ size_t DropCrowdedSheetSeeds(SeedState& s, size_t count);
 /// array alongside it). `where` may be s.position or *carried: it is read before either changes. Returns the
 /// count dropped.
 size_t ThinCrowded(SeedState& s, const std::vector<Vec3>& where, const std::vector<double>& misfit, double limit,
-                   std::vector<Vec3>* carried = nullptr);
+                   double curve_separation, std::vector<Vec3>* carried = nullptr);
 
 /// A trial seed of RefineFeatureChains: from a chord (a, b) or from one spacing beyond a chain's end at a.
 struct ChainTrial {
@@ -91,7 +93,9 @@ double LandedOnItsFeature(const SeedState& s, const ChainTrial& c, const Vec3& l
 /// next analysis and stepped onto the corner, crowding it, and the thinning may then keep the one beside the
 /// corner (open corners of crossing-planes and three-discs: a non-manifold edge 0.004–0.01 off the curve,
 /// and 0.3–0.5 off it at a rim's corner).
+/// A curve seed of another curve (OnTwoCurves with `tangent`, the tangents of the n seeds, and `t_new`, the
+/// landed seed's) does not crowd it.
 bool Crowded(const SeedState& s, size_t n, const SeedIndex& index, const Vec3& landed, int rank, double crowd_radius,
-             double spacing);
+             double spacing, const Vec3& t_new, const std::vector<Vec3>& tangent, double curve_separation);
 
 }  // namespace voroudf

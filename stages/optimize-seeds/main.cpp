@@ -42,6 +42,7 @@ int main(int argc, char** argv) {
   app.add_option("--sigma-max-spacing", o.sigma_max_spacing, "kernel width at most this x mean seed spacing (0: no cap)");
   app.add_option("--sigma-min-spacing", o.sigma_min_spacing, "kernel width at least this x mean seed spacing (0: the paper's minimum distance alone)");
   app.add_option("--feature-clearance", o.feature_clearance, "thin feature seeds to this x mean spacing and keep sheet seeds that far from them (0: none)");
+  app.add_option("--curve-separation", o.curve_separation, "curve seeds this x mean spacing or more apart across their tangents, on a chord off the tangents' bisector, are on two curves: kept and chained apart (0: never)");
   app.add_option("--feature-steps", o.feature_steps, "L1 steps of the feature seeds alone after the outer loop");
   app.add_option("--feature-gap-max", o.feature_gap_max, "add a seed between two consecutive seeds of a feature chain farther apart than this x mean spacing, and extend chain ends along their curve (0: never)");
   app.add_option("--feature-chord-tol", o.feature_chord_tol, "add a seed where a feature curve leaves the chord between two of its seeds by more than this x mean spacing (0: never)");

@@ -48,6 +48,7 @@ void OptimizeSeedsOptions::Check() const {
   if (!(sigma_max_spacing >= 0.0 && sigma_max_spacing <= 10.0)) throw UsageError("--sigma-max-spacing must be in [0, 10]");
   if (!(sigma_min_spacing >= 0.0 && sigma_min_spacing <= 10.0)) throw UsageError("--sigma-min-spacing must be in [0, 10]");
   if (!(feature_clearance >= 0.0 && feature_clearance <= 1.0)) throw UsageError("--feature-clearance must be in [0, 1]");
+  if (!(curve_separation >= 0.0 && curve_separation <= 2.0)) throw UsageError("--curve-separation must be in [0, 2]");
   if (feature_steps < 0) throw UsageError("--feature-steps must be at least 0");
   if (!(feature_chord_tol >= 0.0 && feature_chord_tol <= 1.0)) throw UsageError("--feature-chord-tol must be in [0, 1]");
   if (!(feature_gap_max == 0.0 || (feature_gap_max >= 1.0 && feature_gap_max <= kFeatureLinkRadius)))
@@ -302,7 +303,9 @@ size_t SettleFeatures(Optimizer& opt, SeedState& s, const OptimizeSeedsOptions& 
     // Seeds whose steps meet are thinned before the move (the better fitting target stays): otherwise two
     // corner seeds both step onto one corner, Project undoes both moves as too near, and neither reaches it.
     if (options.feature_clearance > 0.0) {
-      crowded += ThinCrowded(s, targets, misfit, options.feature_clearance * opt.MeanSpacing(s.position), &targets);
+      const double spacing = opt.MeanSpacing(s.position);
+      crowded += ThinCrowded(s, targets, misfit, options.feature_clearance * spacing, options.curve_separation * spacing,
+                             &targets);
     }
     const std::vector<Vec3> before = s.position;
     opt.Project(s, before, std::move(targets), 0.25 * opt.MeanSpacing(s.position));
