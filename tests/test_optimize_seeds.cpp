@@ -1173,19 +1173,20 @@ TEST(OptimizeSeeds, ChordsOffTheTangentsBisectorJoinTwoCurves) {
   const Vec3 x = Vec3::UnitX(), y = Vec3::UnitY();
   for (double angle : {0.2, 0.5, 1.0}) {  // on the unit circle: one curve, whatever the separation asked
     const Vec3 b(std::cos(angle), std::sin(angle), 0), t_b(-std::sin(angle), std::cos(angle), 0);
-    EXPECT_FALSE(OnTwoCurves(Vec3(1, 0, 0), y, b, t_b, 1e-6)) << angle;
+    EXPECT_FALSE(OnTwoCurves(Vec3(1, 0, 0), y, b, t_b, TwoCurves{1e-6})) << angle;
   }
   // Parallel lines 0.1 apart: the seed across at 0.3 along is 18° off the tangents, at 1.0 along 6°.
-  EXPECT_TRUE(OnTwoCurves(Vec3::Zero(), x, Vec3(0.3, 0.1, 0), -x, 0.09));
-  EXPECT_FALSE(OnTwoCurves(Vec3::Zero(), x, Vec3(0.3, 0.1, 0), x, 0.11)) << "closer than the separation asked";
-  EXPECT_FALSE(OnTwoCurves(Vec3::Zero(), x, Vec3(1.0, 0.1, 0), x, 0.05));
-  EXPECT_FALSE(OnTwoCurves(Vec3::Zero(), x, Vec3(0.3, 0.1, 0), Vec3::Zero(), 0.05)) << "no tangent";
-  EXPECT_FALSE(OnTwoCurves(Vec3::Zero(), x, Vec3(0.3, 0.1, 0), x, 0.0)) << "off";
+  EXPECT_TRUE(OnTwoCurves(Vec3::Zero(), x, Vec3(0.3, 0.1, 0), -x, TwoCurves{0.09}));
+  EXPECT_FALSE(OnTwoCurves(Vec3::Zero(), x, Vec3(0.3, 0.1, 0), -x, TwoCurves{0.09, 20.0})) << "tangents trusted to 10°";
+  EXPECT_FALSE(OnTwoCurves(Vec3::Zero(), x, Vec3(0.3, 0.1, 0), x, TwoCurves{0.11})) << "closer than the separation asked";
+  EXPECT_FALSE(OnTwoCurves(Vec3::Zero(), x, Vec3(1.0, 0.1, 0), x, TwoCurves{0.05}));
+  EXPECT_FALSE(OnTwoCurves(Vec3::Zero(), x, Vec3(0.3, 0.1, 0), Vec3::Zero(), TwoCurves{0.05})) << "no tangent";
+  EXPECT_FALSE(OnTwoCurves(Vec3::Zero(), x, Vec3(0.3, 0.1, 0), x, TwoCurves{})) << "off";
   // The feature-seed thinning keeps both rims' seeds with a separation, one of them without.
   const std::vector<Vec3> position = {{0, 0, 0}, {0.01, 0.015, 0}};
   const std::vector<uint8_t> rank = {2, 2};
-  EXPECT_EQ(SeedsBesideFeatures(position, rank, 0.03, {}, {x, x}, 0.01), (std::vector<char>{0, 0}));
-  EXPECT_EQ(SeedsBesideFeatures(position, rank, 0.03, {}, {x, x}, 0.0), (std::vector<char>{0, 1}));
+  EXPECT_EQ(SeedsBesideFeatures(position, rank, 0.03, {}, {x, x}, TwoCurves{0.01}), (std::vector<char>{0, 0}));
+  EXPECT_EQ(SeedsBesideFeatures(position, rank, 0.03, {}, {x, x}, TwoCurves{}), (std::vector<char>{0, 1}));
 }
 
 // A plate whose edge faces are half a spacing wide: each of its 8 long rims gets its own chain of curve

@@ -10,13 +10,14 @@
 
 namespace voroudf {
 
-bool OnTwoCurves(const Vec3& a, const Vec3& t_a, const Vec3& b, const Vec3& t_b, double min_separation) {
+bool OnTwoCurves(const Vec3& a, const Vec3& t_a, const Vec3& b, const Vec3& t_b, const TwoCurves& test) {
+  const double min_separation = test.min_separation;
   if (!(min_separation > 0.0) || t_a.squaredNorm() == 0.0 || t_b.squaredNorm() == 0.0) return false;
   const Vec3 ab = b - a;
   if ((ab - ab.dot(t_a) * t_a).norm() < min_separation || (ab - ab.dot(t_b) * t_b).norm() < min_separation)
     return false;
   const Vec3 bisector = (t_a + (t_a.dot(t_b) < 0.0 ? Vec3(-t_b) : t_b)).normalized();
-  return std::abs(bisector.dot(ab.normalized())) < std::cos(kTwoCurvesBisectorDeg * M_PI / 180.0);
+  return std::abs(bisector.dot(ab.normalized())) < std::cos(test.bisector_deg * M_PI / 180.0);
 }
 
 std::vector<Vec3> Tangents(const SeedState& s) {
@@ -39,7 +40,7 @@ double TangentMisfit(const CellSamples& cells, size_t i, const Vec3& x) {
 }
 
 FeatureLinks FindFeatureLinks(const SeedState& s, const std::vector<Vec3>& tangent, double radius,
-                              double curve_separation) {
+                              const TwoCurves& two_curves) {
   const size_t n = s.position.size();
   FeatureLinks links;
   const SeedIndex index(s.position);
@@ -55,7 +56,7 @@ FeatureLinks FindFeatureLinks(const SeedState& s, const std::vector<Vec3>& tange
       const double along = e.dot(tangent[i]);
       if (std::abs(along) < 0.8 * e.norm()) continue;
       if (!tangent[uj].isZero() && std::abs(e.dot(tangent[uj])) < 0.8 * e.norm()) continue;
-      if (OnTwoCurves(s.position[i], tangent[i], s.position[uj], tangent[uj], curve_separation)) continue;
+      if (OnTwoCurves(s.position[i], tangent[i], s.position[uj], tangent[uj], two_curves)) continue;
       int& side = best[along > 0.0 ? 0 : 1];
       if (side < 0) side = j;
     }
@@ -136,10 +137,10 @@ size_t DropCrowdedSheetSeeds(SeedState& s, size_t count) {
 }
 
 size_t ThinCrowded(SeedState& s, const std::vector<Vec3>& where, const std::vector<double>& misfit, double limit,
-                   double curve_separation, std::vector<Vec3>* carried) {
+                   const TwoCurves& two_curves, std::vector<Vec3>* carried) {
   std::vector<uint8_t> ranks(s.rank.size());
   for (size_t i = 0; i < ranks.size(); ++i) ranks[i] = static_cast<uint8_t>(s.rank[i].rank);
-  const std::vector<char> drop = SeedsBesideFeatures(where, ranks, limit, misfit, Tangents(s), curve_separation);
+  const std::vector<char> drop = SeedsBesideFeatures(where, ranks, limit, misfit, Tangents(s), two_curves);
   const size_t dropped = static_cast<size_t>(std::count(drop.begin(), drop.end(), 1));
   if (dropped == 0) return 0;
   EraseSeeds(s, drop);
@@ -154,7 +155,7 @@ size_t ThinCrowded(SeedState& s, const std::vector<Vec3>& where, const std::vect
 
 std::vector<char> SeedsBesideFeatures(const std::vector<Vec3>& position, const std::vector<uint8_t>& rank, double limit,
                                       const std::vector<double>& misfit, const std::vector<Vec3>& tangent,
-                                      double curve_separation) {
+                                      const TwoCurves& two_curves) {
   if (!misfit.empty() && misfit.size() != position.size()) throw std::invalid_argument("SeedsBesideFeatures: misfit size");
   if (!tangent.empty() && tangent.size() != position.size()) throw std::invalid_argument("SeedsBesideFeatures: tangent size");
   const size_t n = position.size();
@@ -203,9 +204,9 @@ std::vector<char> SeedsBesideFeatures(const std::vector<Vec3>& position, const s
     index.WithinRadius(position[i], limit, found);
     for (int f : found) {
       const size_t j = feature_id[static_cast<size_t>(f)];
-      const bool two_curves = clamped(i) == 2 && clamped(j) == 2 && !tangent.empty() &&
-                              OnTwoCurves(position[i], tangent[i], position[j], tangent[j], curve_separation);
-      if (kept[j] && !two_curves) drop[i] = 1;
+      const bool other_curve = clamped(i) == 2 && clamped(j) == 2 && !tangent.empty() &&
+                               OnTwoCurves(position[i], tangent[i], position[j], tangent[j], two_curves);
+      if (kept[j] && !other_curve) drop[i] = 1;
     }
     if (!drop[i] && clamped(i) < 2 && !tangent.empty()) {
       index.WithinRadius(position[i], 3.0 * limit, found);
@@ -277,16 +278,16 @@ double LandedOnItsFeature(const SeedState& s, const ChainTrial& c, const Vec3& l
 }
 
 bool Crowded(const SeedState& s, size_t n, const SeedIndex& index, const Vec3& landed, int rank, double crowd_radius,
-             double spacing, const Vec3& t_new, const std::vector<Vec3>& tangent, double curve_separation) {
+             double spacing, const Vec3& t_new, const std::vector<Vec3>& tangent, const TwoCurves& two_curves) {
   std::vector<int> near;
   index.WithinRadius(landed, std::max(crowd_radius, spacing), near);
   for (int j : near) {
     const int rank_j = s.rank[static_cast<size_t>(j)].rank;
     const double d = (s.position[static_cast<size_t>(j)] - landed).norm();
-    const bool two_curves = rank == 2 && rank_j == 2 &&
-                            OnTwoCurves(landed, t_new, s.position[static_cast<size_t>(j)],
-                                        tangent[static_cast<size_t>(j)], curve_separation);
-    if ((rank_j >= 2 && d < crowd_radius && !two_curves) || (rank_j == 3 && rank == 2)) return true;
+    const bool other_curve = rank == 2 && rank_j == 2 &&
+                             OnTwoCurves(landed, t_new, s.position[static_cast<size_t>(j)],
+                                         tangent[static_cast<size_t>(j)], two_curves);
+    if ((rank_j >= 2 && d < crowd_radius && !other_curve) || (rank_j == 3 && rank == 2)) return true;
   }
   for (size_t k = n; k < s.position.size(); ++k)
     if ((s.position[k] - landed).norm() < crowd_radius) return true;

@@ -10,6 +10,7 @@
 
 #include "common/types.h"
 #include "stages/optimize-seeds/l1_tangent.h"
+#include "stages/optimize-seeds/optimize_seeds.h"
 #include "stages/optimize-seeds/repulsion.h"
 #include "stages/optimize-seeds/seed_index.h"
 #include "stages/optimize-seeds/voronoi_cells.h"
@@ -41,9 +42,9 @@ struct FeatureLinks {
   std::vector<std::pair<int, Vec3>> ends;
 };
 
-/// `curve_separation`: seeds on two curves (OnTwoCurves) are never linked.
+/// Seeds on two curves (OnTwoCurves with `two_curves`) are never linked.
 FeatureLinks FindFeatureLinks(const SeedState& s, const std::vector<Vec3>& tangent, double radius,
-                              double curve_separation);
+                              const TwoCurves& two_curves);
 
 /// Removes the seeds marked in `drop` from every array of the state, keeping the others' order.
 void EraseSeeds(SeedState& s, const std::vector<char>& drop);
@@ -64,7 +65,7 @@ size_t DropCrowdedSheetSeeds(SeedState& s, size_t count);
 /// array alongside it). `where` may be s.position or *carried: it is read before either changes. Returns the
 /// count dropped.
 size_t ThinCrowded(SeedState& s, const std::vector<Vec3>& where, const std::vector<double>& misfit, double limit,
-                   double curve_separation, std::vector<Vec3>* carried = nullptr);
+                   const TwoCurves& two_curves, std::vector<Vec3>* carried = nullptr);
 
 /// A trial seed of RefineFeatureChains: from a chord (a, b) or from one spacing beyond a chain's end at a.
 struct ChainTrial {
@@ -96,6 +97,6 @@ double LandedOnItsFeature(const SeedState& s, const ChainTrial& c, const Vec3& l
 /// A curve seed of another curve (OnTwoCurves with `tangent`, the tangents of the n seeds, and `t_new`, the
 /// landed seed's) does not crowd it.
 bool Crowded(const SeedState& s, size_t n, const SeedIndex& index, const Vec3& landed, int rank, double crowd_radius,
-             double spacing, const Vec3& t_new, const std::vector<Vec3>& tangent, double curve_separation);
+             double spacing, const Vec3& t_new, const std::vector<Vec3>& tangent, const TwoCurves& two_curves);
 
 }  // namespace voroudf

@@ -304,7 +304,7 @@ size_t SettleFeatures(Optimizer& opt, SeedState& s, const OptimizeSeedsOptions& 
     // corner seeds both step onto one corner, Project undoes both moves as too near, and neither reaches it.
     if (options.feature_clearance > 0.0) {
       const double spacing = opt.MeanSpacing(s.position);
-      crowded += ThinCrowded(s, targets, misfit, options.feature_clearance * spacing, options.curve_separation * spacing,
+      crowded += ThinCrowded(s, targets, misfit, options.feature_clearance * spacing, opt.TwoCurveTest(spacing),
                              &targets);
     }
     const std::vector<Vec3> before = s.position;

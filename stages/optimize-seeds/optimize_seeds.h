@@ -126,25 +126,32 @@ struct OuterIterationReport {
 ///                  sheet seed is also marked when it lies within `limit` of the segment between two kept
 ///                  feature seeds (within 3 × `limit` of it) that runs along their tangents (|cos| ≥ 0.9):
 ///                  between two curve seeds, it is as near the curve as beside one.
-/// \param curve_separation  with `tangent`: a curve seed is kept beside a kept curve seed of another curve
-///                  (OnTwoCurves with this separation, world units; 0: never).
+/// \param two_curves  with `tangent`: a curve seed is kept beside a kept curve seed of another curve
+///                  (OnTwoCurves).
 /// \return          per seed, 1 if it should be dropped
-std::vector<char> SeedsBesideFeatures(const std::vector<Vec3>& position, const std::vector<uint8_t>& rank, double limit,
-                                      const std::vector<double>& misfit = {}, const std::vector<Vec3>& tangent = {},
-                                      double curve_separation = 0.0);
-
-/// The bisector test of OnTwoCurves, degrees.
+/// The bisector test of OnTwoCurves on exact tangents, degrees.
 constexpr double kTwoCurvesBisectorDeg = 15.0;
 
+/// The two-curve test's thresholds (OnTwoCurves). The default never finds two curves.
+struct TwoCurves {
+  double min_separation = 0.0;                 ///< world units; 0: off
+  double bisector_deg = kTwoCurvesBisectorDeg;  ///< more off the tangents' bisector than this: two curves
+};
+
+std::vector<char> SeedsBesideFeatures(const std::vector<Vec3>& position, const std::vector<uint8_t>& rank, double limit,
+                                      const std::vector<double>& misfit = {}, const std::vector<Vec3>& tangent = {},
+                                      const TwoCurves& two_curves = {});
+
 /// Whether curve seeds at a and b, with unit tangents t_a and t_b, lie on two curves rather than on one: the
-/// chord ab runs more than kTwoCurvesBisectorDeg off the bisector of the two tangents (on one smooth curve a
+/// chord ab runs more than `test.bisector_deg` off the bisector of the two tangents (on one smooth curve a
 /// chord bisects its ends' tangents; a circular arc's does exactly), and each lies at least
-/// `min_separation` (world units) from the other's tangent line. Why the separation: parallel curves closer
+/// `test.min_separation` (world units) from the other's tangent line. Why the separation: parallel curves closer
 /// than about half a spacing bound a strip that build-gvd's samples do not resolve, and both chains there
 /// give a dual with holes (a 2 × 2 slab at 800 seeds: edge faces 0.33 and 0.41 spacings wide, TD 7 and 8;
-/// 0.49 and 0.65, TD 0); such curves stay one chain, as before. False where a tangent is zero or
-/// min_separation <= 0.
-bool OnTwoCurves(const Vec3& a, const Vec3& t_a, const Vec3& b, const Vec3& t_b, double min_separation);
+/// 0.49 and 0.65, TD 0); such curves stay one chain, as before. Where the field's gradients are off by θ the
+/// tangents are too, and the bisector by up to θ: the caller widens `bisector_deg` to 2θ. False where a
+/// tangent is zero or min_separation <= 0.
+bool OnTwoCurves(const Vec3& a, const Vec3& t_a, const Vec3& b, const Vec3& t_b, const TwoCurves& test);
 
 /// Paper Alg. 1 lines 2–16 (Sec. 3.1 Eqs. energy_l1 / energy_l1_regularizer, Sec. 3.2 Eqs. particle /
 /// particle_proj). Input seeds are first projected onto the zero set (seeds that do not converge and exact

@@ -276,7 +276,7 @@ size_t Optimizer::RefineFeatureChains(SeedState& s, double bend_tol, double max_
     const size_t n = s.position.size();
     const std::vector<Vec3> tangent = Tangents(s);
     const FeatureLinks links = FindFeatureLinks(s, tangent, kFeatureLinkRadius * spacing,
-                                                 options_.curve_separation * spacing);
+                                                 TwoCurveTest(spacing));
     // After the first round only links with a seed added in the last round can have changed.
     const size_t fresh = round > 0 ? n - last_added : 0;
     const std::vector<ChainTrial> trials = ChainTrials(s, links, fresh, bend_tol, max_gap, clearance, spacing);
@@ -313,7 +313,7 @@ size_t Optimizer::RefineFeatureChains(SeedState& s, double bend_tol, double max_
       const Vec3 t_new = rank == 2 ? Vec3(trial.space[n + t].basis.col(0)) : Vec3::Zero();
       const double crowd_radius = LandedOnItsFeature(s, c, landed[t], rank, t_new, bend_tol, max_gap, spacing);
       if (crowd_radius < 0.0 || Crowded(s, n, index, landed[t], rank, std::max(crowd_radius, clearance), spacing, t_new, tangent,
-                                     options_.curve_separation * spacing) ||
+                                     TwoCurveTest(spacing)) ||
           s.position.size() >= max_count)
         continue;
       s.position.push_back(landed[t]);
@@ -358,7 +358,7 @@ size_t Optimizer::DropCrowded(SeedState& s, const CellSamples& cells) const {
   std::vector<double> misfit(s.position.size());
   for (size_t i = 0; i < misfit.size(); ++i) misfit[i] = TangentMisfit(cells, i, s.position[i]);
   const double spacing = MeanSpacing(s.position);
-  return ThinCrowded(s, s.position, misfit, options_.feature_clearance * spacing, options_.curve_separation * spacing);
+  return ThinCrowded(s, s.position, misfit, options_.feature_clearance * spacing, TwoCurveTest(spacing));
 }
 
 std::pair<double, double> Optimizer::SpacingStats(const std::vector<Vec3>& positions) const {

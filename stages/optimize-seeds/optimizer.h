@@ -107,6 +107,11 @@ class Optimizer {
 
   // Same summation order as SpacingStats, so the value is bit-identical to its mean.
   double MeanSpacing(const std::vector<Vec3>& positions) const { return SpacingStats(positions).first; }
+  // OnTwoCurves' thresholds at `spacing`: the option's separation; the bisector test widened to twice the
+  // field's measured gradient error, which the tangents carry (exact fields measure under 2.5°: unchanged).
+  TwoCurves TwoCurveTest(double spacing) const {
+    return {options_.curve_separation * spacing, std::max(kTwoCurvesBisectorDeg, 2.0 * gradient_error_ * 180.0 / M_PI)};
+  }
 
   NeighbourLists RepulsionNeighbours(const std::vector<Vec3>& positions, double radius) const;
 
