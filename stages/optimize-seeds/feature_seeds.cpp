@@ -11,10 +11,9 @@
 namespace voroudf {
 
 bool OnTwoCurves(const Vec3& a, const Vec3& t_a, const Vec3& b, const Vec3& t_b, const TwoCurves& test) {
-  const double min_separation = test.min_separation;
-  if (!(min_separation > 0.0) || t_a.squaredNorm() == 0.0 || t_b.squaredNorm() == 0.0) return false;
+  if (!(test.min_separation > 0.0) || t_a.squaredNorm() == 0.0 || t_b.squaredNorm() == 0.0) return false;
   const Vec3 ab = b - a;
-  if ((ab - ab.dot(t_a) * t_a).norm() < min_separation || (ab - ab.dot(t_b) * t_b).norm() < min_separation)
+  if ((ab - ab.dot(t_a) * t_a).norm() < test.min_separation || (ab - ab.dot(t_b) * t_b).norm() < test.min_separation)
     return false;
   const Vec3 bisector = (t_a + (t_a.dot(t_b) < 0.0 ? Vec3(-t_b) : t_b)).normalized();
   return std::abs(bisector.dot(ab.normalized())) < std::cos(test.bisector_deg * M_PI / 180.0);
@@ -204,9 +203,9 @@ std::vector<char> SeedsBesideFeatures(const std::vector<Vec3>& position, const s
     index.WithinRadius(position[i], limit, found);
     for (int f : found) {
       const size_t j = feature_id[static_cast<size_t>(f)];
-      const bool other_curve = clamped(i) == 2 && clamped(j) == 2 && !tangent.empty() &&
-                               OnTwoCurves(position[i], tangent[i], position[j], tangent[j], two_curves);
-      if (kept[j] && !other_curve) drop[i] = 1;
+      if (kept[j] && !(clamped(i) == 2 && clamped(j) == 2 && !tangent.empty() &&
+                       OnTwoCurves(position[i], tangent[i], position[j], tangent[j], two_curves)))
+        drop[i] = 1;
     }
     if (!drop[i] && clamped(i) < 2 && !tangent.empty()) {
       index.WithinRadius(position[i], 3.0 * limit, found);
@@ -284,10 +283,11 @@ bool Crowded(const SeedState& s, size_t n, const SeedIndex& index, const Vec3& l
   for (int j : near) {
     const int rank_j = s.rank[static_cast<size_t>(j)].rank;
     const double d = (s.position[static_cast<size_t>(j)] - landed).norm();
-    const bool other_curve = rank == 2 && rank_j == 2 &&
-                             OnTwoCurves(landed, t_new, s.position[static_cast<size_t>(j)],
-                                         tangent[static_cast<size_t>(j)], two_curves);
-    if ((rank_j >= 2 && d < crowd_radius && !other_curve) || (rank_j == 3 && rank == 2)) return true;
+    if (rank_j >= 2 && d < crowd_radius &&
+        !(rank == 2 && rank_j == 2 &&
+          OnTwoCurves(landed, t_new, s.position[static_cast<size_t>(j)], tangent[static_cast<size_t>(j)], two_curves)))
+      return true;
+    if (rank_j == 3 && rank == 2) return true;
   }
   for (size_t k = n; k < s.position.size(); ++k)
     if ((s.position[k] - landed).norm() < crowd_radius) return true;

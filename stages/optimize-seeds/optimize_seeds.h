@@ -109,6 +109,15 @@ struct OuterIterationReport {
   double seconds = 0.0;
 };
 
+/// The bisector test of OnTwoCurves on exact tangents, degrees.
+constexpr double kTwoCurvesBisectorDeg = 15.0;
+
+/// The two-curve test's thresholds (OnTwoCurves). The default never finds two curves.
+struct TwoCurves {
+  double min_separation = 0.0;                 ///< world units; 0: off
+  double bisector_deg = kTwoCurvesBisectorDeg;  ///< more off the tangents' bisector than this: two curves
+};
+
 /// Marks the seeds that crowd a feature seed: feature seeds (rank ≥ 2) are thinned greedily, corners (rank 3)
 /// before curves (rank 2), so that no two lie nearer than `limit`; then every sheet seed (rank < 2) nearer
 /// than `limit` to a kept feature seed is marked. Within a rank, seeds with a lower misfit are kept first.
@@ -129,15 +138,6 @@ struct OuterIterationReport {
 /// \param two_curves  with `tangent`: a curve seed is kept beside a kept curve seed of another curve
 ///                  (OnTwoCurves).
 /// \return          per seed, 1 if it should be dropped
-/// The bisector test of OnTwoCurves on exact tangents, degrees.
-constexpr double kTwoCurvesBisectorDeg = 15.0;
-
-/// The two-curve test's thresholds (OnTwoCurves). The default never finds two curves.
-struct TwoCurves {
-  double min_separation = 0.0;                 ///< world units; 0: off
-  double bisector_deg = kTwoCurvesBisectorDeg;  ///< more off the tangents' bisector than this: two curves
-};
-
 std::vector<char> SeedsBesideFeatures(const std::vector<Vec3>& position, const std::vector<uint8_t>& rank, double limit,
                                       const std::vector<double>& misfit = {}, const std::vector<Vec3>& tangent = {},
                                       const TwoCurves& two_curves = {});
@@ -147,8 +147,8 @@ std::vector<char> SeedsBesideFeatures(const std::vector<Vec3>& position, const s
 /// chord bisects its ends' tangents; a circular arc's does exactly), and each lies at least
 /// `test.min_separation` (world units) from the other's tangent line. Why the separation: parallel curves closer
 /// than about half a spacing bound a strip that build-gvd's samples do not resolve, and both chains there
-/// give a dual with holes (a 2 × 2 slab at 800 seeds: edge faces 0.33 and 0.41 spacings wide, TD 7 and 8;
-/// 0.49 and 0.65, TD 0); such curves stay one chain, as before. Where the field's gradients are off by θ the
+/// give a dual with holes (docs/optimize-seeds.md, "Two curves side by side"); such curves stay one chain.
+/// Where the field's gradients are off by θ the
 /// tangents are too, and the bisector by up to θ: the caller widens `bisector_deg` to 2θ. False where a
 /// tangent is zero or min_separation <= 0.
 bool OnTwoCurves(const Vec3& a, const Vec3& t_a, const Vec3& b, const Vec3& t_b, const TwoCurves& test);

@@ -275,8 +275,8 @@ size_t Optimizer::RefineFeatureChains(SeedState& s, double bend_tol, double max_
     Analyze(s);
     const size_t n = s.position.size();
     const std::vector<Vec3> tangent = Tangents(s);
-    const FeatureLinks links = FindFeatureLinks(s, tangent, kFeatureLinkRadius * spacing,
-                                                 TwoCurveTest(spacing));
+    const TwoCurves two_curves = TwoCurveTest(spacing);
+    const FeatureLinks links = FindFeatureLinks(s, tangent, kFeatureLinkRadius * spacing, two_curves);
     // After the first round only links with a seed added in the last round can have changed.
     const size_t fresh = round > 0 ? n - last_added : 0;
     const std::vector<ChainTrial> trials = ChainTrials(s, links, fresh, bend_tol, max_gap, clearance, spacing);
@@ -312,8 +312,9 @@ size_t Optimizer::RefineFeatureChains(SeedState& s, double bend_tol, double max_
       if (!r.converged[t] || rank < 2) continue;
       const Vec3 t_new = rank == 2 ? Vec3(trial.space[n + t].basis.col(0)) : Vec3::Zero();
       const double crowd_radius = LandedOnItsFeature(s, c, landed[t], rank, t_new, bend_tol, max_gap, spacing);
-      if (crowd_radius < 0.0 || Crowded(s, n, index, landed[t], rank, std::max(crowd_radius, clearance), spacing, t_new, tangent,
-                                     TwoCurveTest(spacing)) ||
+      if (crowd_radius < 0.0 ||
+          Crowded(s, n, index, landed[t], rank, std::max(crowd_radius, clearance), spacing, t_new, tangent,
+                  two_curves) ||
           s.position.size() >= max_count)
         continue;
       s.position.push_back(landed[t]);
