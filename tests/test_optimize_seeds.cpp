@@ -149,6 +149,44 @@ TEST(FittedSamplePlanes, TwinsAndFloorsAreCentredOnTheSurface) {
   }
 }
 
+// Planes through |d + e| with e = e0 + c x: each side's zero set, σ z + e(x) = 0 for the side σ = ±1, is
+// tilted by atan c, the two sides' the mirror image of each other, and their mid-plane is the surface.
+// Samples that kept their gradients' planes take that mid-plane, normal ±z, whatever e0's sign; fitted
+// samples keep their normals and only move their values.
+TEST(FittedSamplePlanes, KeptPlanesTakeTheMidPlaneWhereMirroredTiltsCancel) {
+  const double c = 0.05;
+  for (double e0 : {-2e-3, 3e-3}) {
+    CellSamples cells = PlaneCell(0.0, 100, 0.1, 8);
+    for (size_t k = 0; k < cells.point.size(); ++k) {
+      Vec3& p = cells.point[k];
+      const double side = p.z() < 0 ? -1.0 : 1.0;
+      if (std::abs(p.z()) < 0.02) p.z() = 0.02 * side;  // beyond the twins
+      const Vec3 n = Vec3(c, 0, side) / std::sqrt(1 + c * c);
+      cells.gradient[k] = n;
+      cells.distance[k] = n.dot(p) + e0 / std::sqrt(1 + c * c);
+    }
+    const CellSamples tilted = cells;
+    std::vector<char> fitted(cells.point.size(), 0);
+    for (size_t k = 0; k < fitted.size(); k += 2) fitted[k] = 1;
+    CenterTwinPlanes(cells, 0.05, 1e-9, &fitted);
+    size_t moved = 0;
+    for (size_t k = 0; k < cells.point.size(); ++k) {
+      if (fitted[k]) {
+        EXPECT_EQ(cells.gradient[k], tilted.gradient[k]) << "e0 " << e0 << ", sample " << k;
+        moved += cells.distance[k] != tilted.distance[k];
+        continue;
+      }
+      EXPECT_NEAR(std::abs(cells.gradient[k].z()), 1.0, 1e-12) << "e0 " << e0 << ", sample " << k;
+      EXPECT_NEAR(OffThePlane(cells, k), 0.0, 1e-12) << "e0 " << e0 << ", sample " << k;
+    }
+    EXPECT_GT(moved, 40u);
+    // Without `fitted` (gradient planes) every normal stays.
+    cells = tilted;
+    CenterTwinPlanes(cells, 0.05, 1e-9);
+    EXPECT_EQ(cells.gradient, tilted.gradient);
+  }
+}
+
 TEST(FittedSamplePlanes, SheetsFartherApartThanTheTwinsAreLeftAsTheyAre) {
   const CellSamples wall = ShiftedPlaneCell(-2e-3, 9);  // sheets 4e-3 apart
   CellSamples cells = wall;
@@ -165,6 +203,7 @@ TEST(FittedSamplePlanes, ExactGradientsOnAPlaneAreLeftAsTheyAre) {
   CellSamples cells = exact;
   SamplePlanes planes = FitSamplePlanes(cells, SamplePlaneFit{});
   EXPECT_LT(planes.median_angle, 1e-6);
+  EXPECT_EQ(std::count(planes.fitted.begin(), planes.fitted.end(), 1), static_cast<long>(cells.point.size()));
   UseSamplePlanes(cells, planes);
   for (size_t k = 0; k < cells.point.size(); ++k) {
     EXPECT_LT((cells.gradient[k] - exact.gradient[k]).norm(), 1e-9) << "sample " << k;

@@ -31,7 +31,8 @@ struct Feet {
 // appends each fitted sample's angle to its gradient. Brute force over the cell's ≤ M samples: M² distance
 // tests per cell are cheaper than building a tree for 100 points.
 void FitCell(const CellSamples& cells, size_t begin, size_t end, const SamplePlaneFit& fit,
-             std::vector<Vec3>& normal, std::vector<double>& distance, std::vector<double>& angles) {
+             std::vector<Vec3>& normal, std::vector<double>& distance, std::vector<char>& fitted,
+             std::vector<double>& angles) {
   const size_t m = end - begin;
   const Feet feet(cells, begin, end);
   const std::vector<Vec3>& foot = feet.foot;
@@ -105,6 +106,7 @@ void FitCell(const CellSamples& cells, size_t begin, size_t end, const SamplePla
     if (n.dot(unit[a]) < 0.0) n = -n;
     normal[begin + a] = n;
     distance[begin + a] = n.dot(cells.point[begin + a] - anchor_centre[best]);
+    fitted[begin + a] = 1;
     angles.push_back(std::acos(std::clamp(n.dot(unit[a]), -1.0, 1.0)));
   }
 }
@@ -123,21 +125,23 @@ SamplePlanes FitSamplePlanes(const CellSamples& cells, const SamplePlaneFit& fit
   SamplePlanes planes;
   planes.normal = cells.gradient;
   planes.distance = cells.distance;
+  planes.fitted.assign(cells.point.size(), 0);
   std::vector<std::vector<double>> angles(static_cast<size_t>(std::max(n, 0L)));
 #pragma omp parallel for schedule(dynamic, 16)
   for (long i = 0; i < n; ++i)
     FitCell(cells, cells.sample_offset[static_cast<size_t>(i)], cells.sample_offset[static_cast<size_t>(i) + 1], fit,
-            planes.normal, planes.distance, angles[static_cast<size_t>(i)]);
+            planes.normal, planes.distance, planes.fitted, angles[static_cast<size_t>(i)]);
   std::vector<double> all;
   for (const auto& a : angles) all.insert(all.end(), a.begin(), a.end());
   planes.median_angle = Median(all);
   return planes;
 }
 
-void CenterTwinPlanes(CellSamples& cells, double within, double tolerance) {
+void CenterTwinPlanes(CellSamples& cells, double within, double tolerance, const std::vector<char>* fitted) {
   const long n = static_cast<long>(cells.sample_offset.size()) - 1;
   const double other_side = -std::cos(50.0 * M_PI / 180.0);
   std::vector<double> centred = cells.distance;
+  std::vector<Vec3> centred_normal = cells.gradient;
 #pragma omp parallel for schedule(dynamic, 16)
   for (long i = 0; i < n; ++i) {
     const size_t begin = cells.sample_offset[static_cast<size_t>(i)], end = cells.sample_offset[static_cast<size_t>(i) + 1];
@@ -162,10 +166,23 @@ void CenterTwinPlanes(CellSamples& cells, double within, double tolerance) {
       }
       if (best == SIZE_MAX) continue;
       const double gap = unit[a].dot(foot[a] - foot[best]);
-      if (std::abs(gap) < within) centred[begin + a] += 0.5 * gap;
+      if (std::abs(gap) >= within) continue;
+      if (fitted == nullptr || (*fitted)[begin + a]) {
+        centred[begin + a] += 0.5 * gap;
+        continue;
+      }
+      // A sample that kept its gradient's plane among fitted ones takes the mid-plane of the two: the mean
+      // of their signed distances (with opposite normals exactly value += gap / 2).
+      const Vec3 mid = 0.5 * (unit[a] - unit[best]);
+      const Vec3& p = cells.point[begin + a];
+      const double height = 0.5 * (unit[a].dot(p - foot[a]) - unit[best].dot(p - foot[best]));
+      const double norm = mid.norm();
+      centred_normal[begin + a] = mid / norm;
+      centred[begin + a] = height / norm;
     }
   }
   cells.distance.swap(centred);
+  cells.gradient.swap(centred_normal);
 }
 
 void UseSamplePlanes(CellSamples& cells, SamplePlanes& planes) {

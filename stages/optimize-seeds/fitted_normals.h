@@ -25,6 +25,7 @@ struct SamplePlanes {
   std::vector<Vec3> normal;
   std::vector<double> distance;
   double median_angle = 0.0;  ///< radians
+  std::vector<char> fitted;   ///< per sample: 1 if it took a fitted plane, 0 if it kept its gradient's
 };
 
 /// Sample m of a cell, at p_m with value d_m and gradient g_m, stands for the plane through its foot point
@@ -56,8 +57,14 @@ void UseSamplePlanes(CellSamples& cells, SamplePlanes& planes);
 /// whose samples all face one way keep their planes. Only for fields whose projection merges twins (the
 /// caller's test): an exact field's two sides give the same planes, and where a field's floors come without
 /// twins (a grid's rounded valleys) the foot points are off near the surface only, not by -e for every sample.
+/// With `fitted` (the planes came from FitSamplePlanes, SamplePlanes::fitted), a sample that kept its
+/// gradient's plane (no fit: foot points on an edge line, a corner) takes the mid-plane of its own and its
+/// partner's, normal ∝ n̂_m − n̂_other, value the mean of the two planes' signed distances at p_m: its
+/// gradient's error is then averaged with the partner's, and a tilt the error gives both sides alike (the value
+/// error's slope) cancels. A fitted sample's normal is already the surface's and only its value moves.
 /// \pre within > 0
-void CenterTwinPlanes(CellSamples& cells, double within, double tolerance);
+void CenterTwinPlanes(CellSamples& cells, double within, double tolerance,
+                      const std::vector<char>* fitted = nullptr);
 
 /// How far a field's value errors tilt its zero set (radians), from the values `floor` at `points` where a
 /// projection stopped at a floor or ridge (|d + e| = |e| there, common/projection.h): atan(s / cos 45°), s

@@ -124,6 +124,7 @@ CellSamples Optimizer::Analyze(SeedState& s, bool early) {
   // The cache keeps the field's own values and gradients: a kept cell is fitted afresh.
   cached_cells_ = cells;
   cached_positions_ = s.position;
+  std::vector<char> fitted;
   if (fit_planes_ != 0) {
     SamplePlanes planes = FitSamplePlanes(cells, SamplePlaneFit{});
     gradient_error_ = planes.median_angle;
@@ -133,10 +134,14 @@ CellSamples Optimizer::Analyze(SeedState& s, bool early) {
                            "the zero set %.1f deg: %s", gradient_error_ * 180.0 / M_PI, value_tilt_ * 180.0 / M_PI,
                            fit_planes_ ? "sample planes fitted" : "sample planes from the gradients"));
     }
-    if (fit_planes_ > 0) UseSamplePlanes(cells, planes);
+    if (fit_planes_ > 0) {
+      UseSamplePlanes(cells, planes);
+      fitted.swap(planes.fitted);
+    }
     monitor_.Debug(Format("sample planes: gradients %.2f deg off (median)", gradient_error_ * 180.0 / M_PI));
   }
-  if (centre_twin_planes_) CenterTwinPlanes(cells, projection_.twin_within, projection_.tolerance);
+  if (centre_twin_planes_)
+    CenterTwinPlanes(cells, projection_.twin_within, projection_.tolerance, fitted.empty() ? nullptr : &fitted);
   const long n = static_cast<long>(s.position.size());
   std::vector<TangentRank> ranks(static_cast<size_t>(n));
 #pragma omp parallel for schedule(static)
