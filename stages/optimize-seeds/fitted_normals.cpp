@@ -141,7 +141,9 @@ void CenterTwinPlanes(CellSamples& cells, double within, double tolerance, const
   const long n = static_cast<long>(cells.sample_offset.size()) - 1;
   const double other_side = -std::cos(50.0 * M_PI / 180.0);
   std::vector<double> centred = cells.distance;
-  std::vector<Vec3> centred_normal = cells.gradient;
+  // Only kept samples among fitted ones change their normals.
+  std::vector<Vec3> centred_normal;
+  if (fitted != nullptr) centred_normal = cells.gradient;
 #pragma omp parallel for schedule(dynamic, 16)
   for (long i = 0; i < n; ++i) {
     const size_t begin = cells.sample_offset[static_cast<size_t>(i)], end = cells.sample_offset[static_cast<size_t>(i) + 1];
@@ -182,7 +184,7 @@ void CenterTwinPlanes(CellSamples& cells, double within, double tolerance, const
     }
   }
   cells.distance.swap(centred);
-  cells.gradient.swap(centred_normal);
+  if (fitted != nullptr) cells.gradient.swap(centred_normal);
 }
 
 void UseSamplePlanes(CellSamples& cells, SamplePlanes& planes) {

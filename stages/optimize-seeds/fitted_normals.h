@@ -62,7 +62,7 @@ void UseSamplePlanes(CellSamples& cells, SamplePlanes& planes);
 /// partner's, normal ∝ n̂_m − n̂_other, value the mean of the two planes' signed distances at p_m: its
 /// gradient's error is then averaged with the partner's, and a tilt the error gives both sides alike (the value
 /// error's slope) cancels. A fitted sample's normal is already the surface's and only its value moves.
-/// \pre within > 0
+/// \pre within > 0; fitted, if given, has one entry per sample
 void CenterTwinPlanes(CellSamples& cells, double within, double tolerance,
                       const std::vector<char>* fitted = nullptr);
 
