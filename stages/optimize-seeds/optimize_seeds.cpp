@@ -201,7 +201,7 @@ void OuterIteration(Optimizer& opt, SeedState& s, const OptimizeSeedsOptions& op
   }
   // Alg. 1 line 3: the L1 tangent step, then back onto the zero set.
   const auto l1_t0 = Clock::now();
-  const CellSamples cells = opt.Analyze(s);
+  const CellSamples& cells = opt.Analyze(s);
   const auto l1_t1 = Clock::now();
   const std::vector<Vec3> before = s.position;
   std::vector<Vec3> stepped = opt.L1Step(s, cells);
@@ -277,7 +277,7 @@ size_t SettleFeatures(Optimizer& opt, SeedState& s, const OptimizeSeedsOptions& 
   std::vector<char> movers;
   std::vector<int> near;
   for (int step = 0;; ++step) {
-    const CellSamples cells = opt.Analyze(s);
+    const CellSamples& cells = opt.Analyze(s);
     std::vector<double> misfit;
     std::vector<Vec3> targets;
     bool move = step < most;

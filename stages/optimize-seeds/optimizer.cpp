@@ -96,7 +96,7 @@ double Optimizer::Project(SeedState& s, const std::vector<Vec3>& previous, std::
   return largest;
 }
 
-CellSamples Optimizer::Analyze(SeedState& s, bool early) {
+const CellSamples& Optimizer::Analyze(SeedState& s, bool early) {
   const SeedIndex index(s.position);
   CellSamplingOptions cell_options = cell_options_;
   if (!early) cell_options.early_samples = 0;
@@ -119,11 +119,13 @@ CellSamples Optimizer::Analyze(SeedState& s, bool early) {
   // Seeds dropped since the last call shift the later ones' indices: the cache follows them by position.
   if (!cached_positions_.empty() && cached_positions_.size() != s.position.size())
     CarryCells(s.position, cell_options, cached_cells_, cached_positions_);
-  CellSamples cells = SampleVoronoiCells(udf_, s.position, index, cell_options, options_.seed, round_++,
-                                         cached_positions_.empty() ? nullptr : &cached_cells_, &cached_positions_);
-  // The cache keeps the field's own values and gradients: a kept cell is fitted afresh.
-  cached_cells_ = cells;
+  cached_cells_ = SampleVoronoiCells(udf_, s.position, index, cell_options, options_.seed, round_++,
+                                     cached_positions_.empty() ? nullptr : &cached_cells_, &cached_positions_);
   cached_positions_ = s.position;
+  // The cache keeps the field's own values and gradients (a kept cell is fitted afresh): sample planes are
+  // changed on a copy. Without them the cache is the result, and megabytes are not copied on one thread.
+  if (fit_planes_ != 0 || centre_twin_planes_) planed_cells_ = cached_cells_;
+  CellSamples& cells = fit_planes_ != 0 || centre_twin_planes_ ? planed_cells_ : cached_cells_;
   std::vector<char> fitted;
   if (fit_planes_ != 0) {
     SamplePlanes planes = FitSamplePlanes(cells, SamplePlaneFit{});
@@ -301,7 +303,7 @@ size_t Optimizer::RefineFeatureChains(SeedState& s, double bend_tol, double max_
     }
     trial.rank.resize(trial.position.size());
     trial.space.resize(trial.position.size());
-    const CellSamples cells = Analyze(trial);
+    const CellSamples& cells = Analyze(trial);
     std::vector<char> movers(trial.position.size(), 0);
     std::fill(movers.begin() + static_cast<long>(n), movers.end(), 1);
     std::vector<Vec3> target = L1Step(trial, cells, false, nullptr, &movers);

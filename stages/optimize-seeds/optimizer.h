@@ -47,8 +47,9 @@ class Optimizer {
 
   // Cells, samples, rank and null space of every seed at the current positions. early: the repulsion
   // rounds, which only need ranks and null spaces, let cells that clearly see one plane stop at
-  // --early-samples; the L1 steps and the final ranks take every cell whole.
-  CellSamples Analyze(SeedState& s, bool early = false);
+  // --early-samples; the L1 steps and the final ranks take every cell whole. The cells returned stay valid
+  // until the next call (they are the cache itself unless the sample planes were changed).
+  const CellSamples& Analyze(SeedState& s, bool early = false);
 
   // Between repulsion rounds without new cells (--repulsion-cells first): ranks stay, a seed that moves in a
   // plane (a sheet seed) takes the tangent plane of its own gradient where Project left it, which is the
@@ -143,6 +144,7 @@ class Optimizer {
   ProjectionOptions projection_;
   uint64_t round_ = 0;  // sampling rounds so far: the random stream of every round differs
   CellSamples cached_cells_;             // the last round's cells, reused where nothing nearby moved
+  CellSamples planed_cells_;             // the same with fitted or centred sample planes (noisy fields only)
   std::vector<Vec3> cached_positions_;
   size_t last_short_cells_ = 0;
   double last_acceptance_ = 0.0;

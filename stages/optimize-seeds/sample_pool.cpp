@@ -76,7 +76,7 @@ size_t SamplePool::points() const {
 }
 
 size_t SamplePool::bytes() const {
-  size_t total = values_.capacity() * sizeof(Value) + buckets_.capacity() * sizeof(Bucket) + index_.size() * 32;
+  size_t total = (value_blocks_.size() << kValueBlockBits) * sizeof(Value) + buckets_.capacity() * sizeof(Bucket) + index_.size() * 32;
   for (const Bucket& b : buckets_)
     total += b.entries.capacity() * sizeof(Entry_) + b.begin.capacity() * sizeof(uint32_t);
   return total;
@@ -315,11 +315,17 @@ size_t SamplePool::Evaluate(const Udf& udf, const std::vector<PointId>& ids) {
   std::vector<double> d;
   std::vector<Vec3> g;
   udf.Evaluate(points, d, g);
-  for (size_t k = 0; k < ask.size(); ++k) {
-    if (values_.size() >= static_cast<size_t>(std::numeric_limits<int32_t>::max()))
-      throw NumericalError("sample pool: over 2^31 UDF values");
-    Entry(ask[k]).value = static_cast<int32_t>(values_.size());
-    values_.push_back({d[k], g[k]});
+  const size_t base = value_count_;
+  if (base + ask.size() > static_cast<size_t>(std::numeric_limits<int32_t>::max()))
+    throw NumericalError("sample pool: over 2^31 UDF values");
+  value_count_ += ask.size();
+  const size_t block = size_t{1} << kValueBlockBits;
+  while (value_blocks_.size() * block < value_count_) value_blocks_.emplace_back(new Value[block]);
+#pragma omp parallel for schedule(static)
+  for (long lk = 0; lk < static_cast<long>(ask.size()); ++lk) {
+    const size_t k = static_cast<size_t>(lk), v = base + k;
+    Entry(ask[k]).value = static_cast<int32_t>(v);
+    value_blocks_[v >> kValueBlockBits][v & (block - 1)] = {d[k], g[k]};
   }
   return ask.size();
 }

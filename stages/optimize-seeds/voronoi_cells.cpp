@@ -21,6 +21,24 @@ double InfluenceRadius(double r, const CellSamplingOptions& options) {
   return std::max(2.0, 1.0 / options.radius_factor) * r * (1.0 + 1e-5) + 1e-12;
 }
 
+// The neighbour and sample arrays sized by the offsets already set.
+void SizeToOffsets(CellSamples& cells) {
+  cells.neighbour.resize(cells.neighbour_offset.back());
+  cells.point.resize(cells.sample_offset.back());
+  cells.distance.resize(cells.sample_offset.back());
+  cells.gradient.resize(cells.sample_offset.back());
+}
+
+// Cell i's samples of `from` into `to` from sample `at` on (to's arrays already sized).
+void CopyCellSamples(const CellSamples& from, size_t i, CellSamples& to, size_t at) {
+  const long begin = static_cast<long>(from.sample_offset[i]);
+  const long count = static_cast<long>(from.sample_offset[i + 1]) - begin;
+  const long to_begin = static_cast<long>(at);
+  std::copy_n(from.point.begin() + begin, count, to.point.begin() + to_begin);
+  std::copy_n(from.distance.begin() + begin, count, to.distance.begin() + to_begin);
+  std::copy_n(from.gradient.begin() + begin, count, to.gradient.begin() + to_begin);
+}
+
 // A call's working state: per cell, its neighbours and its candidates (M slots each, `accepted` used) with
 // their UDF values; the pool's choice when there is one.
 struct Draft {
@@ -33,8 +51,10 @@ struct Draft {
   std::vector<char> short_draw;  // the rejection budget ran out before M samples
   std::vector<SamplePool::Cell> shapes;  // with a pool: the cells' shapes, their samples chosen afterwards
   std::vector<std::vector<SamplePool::PointId>> chosen;
-  std::vector<double> cand_d;
-  std::vector<Vec3> cand_g;
+  // Uninitialised: only the accepted slots are written (in parallel) and read; zeroing them all first cost a
+  // serial pass over fresh pages at every call.
+  std::unique_ptr<double[]> cand_d;
+  std::unique_ptr<Vec3[]> cand_g;
 };
 
 // Which cells must be redrawn: all, or (given the previous round) those with a moved seed within their
@@ -190,8 +210,8 @@ void EvaluateCells(const Udf& udf, const CellSamplingOptions& options, const Cel
   cells.early_kept.assign(n, 0);
   for (size_t i = 0; i < n; ++i)
     if (!w.redo[i] && !previous->early_kept.empty()) cells.early_kept[i] = previous->early_kept[i];
-  w.cand_d.assign(n * m_max, 0.0);
-  w.cand_g.assign(n * m_max, Vec3::Zero());
+  w.cand_d.reset(new double[n * m_max]);
+  w.cand_g.reset(new Vec3[n * m_max]);
   const size_t early = options.early_samples > 0 ? std::min(m_max, static_cast<size_t>(options.early_samples)) : m_max;
   EvaluateCandidates(udf, options, 0, early, [](size_t) { return true; }, cells, w);
   if (early == m_max) return;
@@ -202,7 +222,7 @@ void EvaluateCells(const Udf& udf, const CellSamplingOptions& options, const Cel
       more[i] = 1;
       continue;
     }
-    const TangentRank r = ComputeTangentRank(w.cand_g.data() + i * m_max, early, options.early_rank_threshold);
+    const TangentRank r = ComputeTangentRank(w.cand_g.get() + i * m_max, early, options.early_rank_threshold);
     if (r.rank == 1) {
       w.accepted[i] = early;
       cells.early_kept[i] = 1;
@@ -230,24 +250,20 @@ void Assemble(const CellSamples* previous, const Draft& w, CellSamples& cells) {
     }
     if (w.redo[i] && w.short_draw[i]) ++cells.short_cells;
   }
-  cells.neighbour.reserve(cells.neighbour_offset[n]);
-  cells.point.resize(cells.sample_offset[n]);
-  cells.distance.resize(cells.sample_offset[n]);
-  cells.gradient.resize(cells.sample_offset[n]);
-  for (size_t i = 0; i < n; ++i) {
-    cells.neighbour.insert(cells.neighbour.end(), w.neighbours[i].begin(), w.neighbours[i].end());
+  SizeToOffsets(cells);
+  // In parallel: megabytes of samples, and the fresh pages they land on, would otherwise wait on one thread.
+#pragma omp parallel for schedule(static)
+  for (long li = 0; li < static_cast<long>(n); ++li) {
+    const size_t i = static_cast<size_t>(li);
+    std::copy(w.neighbours[i].begin(), w.neighbours[i].end(), cells.neighbour.begin() + static_cast<long>(cells.neighbour_offset[i]));
     const long to = static_cast<long>(cells.sample_offset[i]);
     if (w.redo[i]) {
       const long from = static_cast<long>(i * m_max), count = static_cast<long>(w.accepted[i]);
       std::copy_n(w.candidates.begin() + from, count, cells.point.begin() + to);
-      std::copy_n(w.cand_d.begin() + from, count, cells.distance.begin() + to);
-      std::copy_n(w.cand_g.begin() + from, count, cells.gradient.begin() + to);
+      std::copy_n(w.cand_d.get() + from, count, cells.distance.begin() + to);
+      std::copy_n(w.cand_g.get() + from, count, cells.gradient.begin() + to);
     } else {
-      const long from = static_cast<long>(previous->sample_offset[i]);
-      const long count = static_cast<long>(previous->sample_offset[i + 1]) - from;
-      std::copy_n(previous->point.begin() + from, count, cells.point.begin() + to);
-      std::copy_n(previous->distance.begin() + from, count, cells.distance.begin() + to);
-      std::copy_n(previous->gradient.begin() + from, count, cells.gradient.begin() + to);
+      CopyCellSamples(*previous, i, cells, cells.sample_offset[i]);
     }
   }
 }
@@ -308,33 +324,48 @@ void CarryCells(const std::vector<Vec3>& seeds, const CellSamplingOptions& optio
   if (marks) carried.pool_mark.assign(n, 0.0);
   if (early) carried.early_kept.assign(n, 0);
   std::vector<Vec3> carried_seeds(n, Vec3::Constant(std::numeric_limits<double>::quiet_NaN()));
-  std::vector<int> found;
-  for (size_t i = 0; i < n; ++i) {
-    carried.neighbour_offset[i + 1] = carried.neighbour_offset[i];
-    carried.sample_offset[i + 1] = carried.sample_offset[i];
-    if (old_of[i] < 0) continue;  // moved or new: NaN, no cell
-    const size_t ku = static_cast<size_t>(old_of[i]);
-    carried_seeds[i] = seeds[i];  // not moved, so the cells it cuts stay
-    bool keep = true;
-    for (size_t m = previous.neighbour_offset[ku]; keep && m < previous.neighbour_offset[ku + 1]; ++m)
-      keep = new_of[static_cast<size_t>(previous.neighbour[m])] >= 0;
-    if (keep && gone_index) {
-      gone_index->WithinRadius(seeds[i], InfluenceRadius(previous.radius[ku], options), found);
-      keep = found.empty();
+  // Which cells stay (in parallel), then their offsets, then their samples copied (in parallel): the copy is
+  // megabytes, which one thread made everyone wait for.
+  std::vector<char> kept(n, 0);
+#pragma omp parallel
+  {
+    std::vector<int> found;
+#pragma omp for schedule(dynamic, 64)
+    for (long li = 0; li < static_cast<long>(n); ++li) {
+      const size_t i = static_cast<size_t>(li);
+      if (old_of[i] < 0) continue;  // moved or new: NaN, no cell
+      const size_t ku = static_cast<size_t>(old_of[i]);
+      carried_seeds[i] = seeds[i];  // not moved, so the cells it cuts stay
+      bool keep = true;
+      for (size_t m = previous.neighbour_offset[ku]; keep && m < previous.neighbour_offset[ku + 1]; ++m)
+        keep = new_of[static_cast<size_t>(previous.neighbour[m])] >= 0;
+      if (keep && gone_index) {
+        gone_index->WithinRadius(seeds[i], InfluenceRadius(previous.radius[ku], options), found);
+        keep = found.empty();
+      }
+      kept[i] = keep;  // else radius 0: its own cell is redrawn
     }
-    if (!keep) continue;  // radius 0: its own cell is redrawn
+  }
+  for (size_t i = 0; i < n; ++i) {
+    const size_t ku = kept[i] ? static_cast<size_t>(old_of[i]) : 0;
+    carried.neighbour_offset[i + 1] = carried.neighbour_offset[i] +
+        (kept[i] ? previous.neighbour_offset[ku + 1] - previous.neighbour_offset[ku] : 0);
+    carried.sample_offset[i + 1] = carried.sample_offset[i] +
+        (kept[i] ? previous.sample_offset[ku + 1] - previous.sample_offset[ku] : 0);
+  }
+  SizeToOffsets(carried);
+#pragma omp parallel for schedule(static)
+  for (long li = 0; li < static_cast<long>(n); ++li) {
+    const size_t i = static_cast<size_t>(li);
+    if (!kept[i]) continue;
+    const size_t ku = static_cast<size_t>(old_of[i]);
     carried.radius[i] = previous.radius[ku];
     if (marks) carried.pool_mark[i] = previous.pool_mark[ku];
     if (early) carried.early_kept[i] = previous.early_kept[ku];
+    size_t to = carried.neighbour_offset[i];
     for (size_t m = previous.neighbour_offset[ku]; m < previous.neighbour_offset[ku + 1]; ++m)
-      carried.neighbour.push_back(static_cast<int>(new_of[static_cast<size_t>(previous.neighbour[m])]));
-    carried.neighbour_offset[i + 1] = carried.neighbour.size();
-    for (size_t m = previous.sample_offset[ku]; m < previous.sample_offset[ku + 1]; ++m) {
-      carried.point.push_back(previous.point[m]);
-      carried.distance.push_back(previous.distance[m]);
-      carried.gradient.push_back(previous.gradient[m]);
-    }
-    carried.sample_offset[i + 1] = carried.point.size();
+      carried.neighbour[to++] = static_cast<int>(new_of[static_cast<size_t>(previous.neighbour[m])]);
+    CopyCellSamples(previous, ku, carried, carried.sample_offset[i]);
   }
   previous = std::move(carried);
   previous_seeds = std::move(carried_seeds);
