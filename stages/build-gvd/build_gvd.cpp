@@ -224,33 +224,32 @@ void MakeNodes(const SeedCloud& seeds, const std::vector<Vec3>& samples, const P
   std::vector<uint64_t> code(raw.size());
 #pragma omp parallel for schedule(static)
   for (long i = 0; i < static_cast<long>(raw.size()); ++i) code[static_cast<size_t>(i)] = MortonCode(raw[static_cast<size_t>(i)], box);
-  std::vector<size_t> order(raw.size());
-  std::iota(order.begin(), order.end(), size_t{0});
-  std::sort(order.begin(), order.end(), [&](size_t a, size_t b) { return code[a] != code[b] ? code[a] < code[b] : a < b; });
+  const std::vector<size_t> order = MortonOrder(raw, box);  // by (code, index), sorted on every thread
   // Which projected sample each node is (its index in `samples`), for the UDF values the projection left.
   std::vector<size_t> sample_of(raw.size(), 0);
   for (size_t i = 0, r = num_seeds; i < total; ++i)
     if (projected.converged[i]) sample_of[r++] = i;
-  std::vector<Vec3> node;
-  std::vector<int> node_seed;  // seed index of a seed node, -1 for a sample
-  std::vector<double> node_d;
-  std::vector<Vec3> node_n;
-  node.reserve(raw.size());
-  node_seed.reserve(raw.size());
-  node_d.reserve(raw.size());
-  node_n.reserve(raw.size());
+  // A node in the Morton cell of the one before it goes: a seed on top of an earlier seed would only add
+  // zero-area triangles and a second layer of faces. Then the kept ones' places, and their copies in parallel.
+  std::vector<size_t> place(order.size() + 1, 0);
   for (size_t k = 0; k < order.size(); ++k) {
-    const size_t r = order[k];
+    const bool duplicate = k > 0 && code[order[k - 1]] == code[order[k]];
+    if (duplicate) ++(order[k] < num_seeds ? stats.seeds_duplicate : stats.samples_duplicate);
+    place[k + 1] = place[k] + (duplicate ? 0 : 1);
+  }
+  const size_t kept = place.back();
+  std::vector<Vec3> node(kept), node_n(kept);
+  std::vector<int> node_seed(kept);  // seed index of a seed node, -1 for a sample
+  std::vector<double> node_d(kept);
+#pragma omp parallel for schedule(static)
+  for (long lk = 0; lk < static_cast<long>(order.size()); ++lk) {
+    const size_t k = static_cast<size_t>(lk), r = order[k], at = place[k];
+    if (place[k + 1] == at) continue;
     const bool is_seed = r < num_seeds;
-    if (k > 0 && code[order[k - 1]] == code[r]) {
-      // A seed on top of an earlier seed would only add zero-area triangles and a second layer of faces.
-      ++(is_seed ? stats.seeds_duplicate : stats.samples_duplicate);
-      continue;
-    }
-    node.push_back(raw[r]);
-    node_seed.push_back(is_seed ? static_cast<int>(r) : -1);
-    node_d.push_back(is_seed ? 0.0 : projected.distance[sample_of[r]]);
-    node_n.push_back(is_seed ? Vec3::Zero() : projected.gradient[sample_of[r]]);
+    node[at] = raw[r];
+    node_seed[at] = is_seed ? static_cast<int>(r) : -1;
+    node_d[at] = is_seed ? 0.0 : projected.distance[sample_of[r]];
+    node_n[at] = is_seed ? Vec3::Zero() : projected.gradient[sample_of[r]];
   }
   *node_out = std::move(node);
   *node_seed_out = std::move(node_seed);
