@@ -412,21 +412,28 @@ std::vector<char> KeptEdges(const Udf& udf, const std::vector<Vec3>& node, const
 // Step 3c: the kept edges as adjacency lists in CSR form, each neighbour list sorted.
 void Adjacency(size_t n, const std::vector<std::pair<int, int>>& edges, const std::vector<char>& keep,
                std::vector<size_t>* offset_out, std::vector<int>* adj_out) {
-  std::vector<size_t> offset(n + 1, 0);
-  for (size_t e = 0; e < edges.size(); ++e)
-    if (keep[e]) {
-      ++offset[static_cast<size_t>(edges[e].first) + 1];
-      ++offset[static_cast<size_t>(edges[e].second) + 1];
+  // Each thread reads every edge but writes only the ends in its own range of nodes: the scattered writes,
+  // most of the time, are shared out, and the result is the one-thread result whatever the threads.
+  const auto for_each_end = [&](auto&& visit) {
+#pragma omp parallel
+    {
+      const size_t parts = static_cast<size_t>(omp_get_num_threads()), part = static_cast<size_t>(omp_get_thread_num());
+      const size_t lo = n * part / parts, hi = n * (part + 1) / parts;
+      for (size_t e = 0; e < edges.size(); ++e) {
+        if (!keep[e]) continue;
+        const size_t a = static_cast<size_t>(edges[e].first), b = static_cast<size_t>(edges[e].second);
+        if (a >= lo && a < hi) visit(a, edges[e].second);
+        if (b >= lo && b < hi) visit(b, edges[e].first);
+      }
     }
+  };
+  std::vector<size_t> offset(n + 1, 0);
+  for_each_end([&](size_t at, int) { ++offset[at + 1]; });
   for (size_t i = 0; i < n; ++i) offset[i + 1] += offset[i];
   std::vector<int> adj(offset[n]);
   {
     std::vector<size_t> fill(offset.begin(), offset.end() - 1);
-    for (size_t e = 0; e < edges.size(); ++e)
-      if (keep[e]) {
-        adj[fill[static_cast<size_t>(edges[e].first)]++] = edges[e].second;
-        adj[fill[static_cast<size_t>(edges[e].second)]++] = edges[e].first;
-      }
+    for_each_end([&](size_t at, int other) { adj[fill[at]++] = other; });
 #pragma omp parallel for schedule(static)
     for (long li = 0; li < static_cast<long>(n); ++li)
       std::sort(adj.begin() + static_cast<long>(offset[static_cast<size_t>(li)]),
