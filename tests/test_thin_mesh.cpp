@@ -15,6 +15,7 @@
 #include "common/shapes.h"
 #include "formats/mesh_io.h"
 #include "formats/seeds_io.h"
+#include "stages/thin-mesh/feature_chords.h"
 #include "stages/thin-mesh/relax.h"
 #include "stages/thin-mesh/rim_flaps.h"
 #include "stages/thin-mesh/thin_mesh.h"
@@ -589,6 +590,71 @@ TriangleMesh CubeGrid(int n, double jitter) {
         }
     }
   return WeldVertices(c, 1e-9);
+}
+
+// A closed cylinder (radius r, |z| <= h) with `segments` vertices round each rim: caps as fans, the side as
+// quads split in two; outward orientation.
+TriangleMesh Cylinder(int segments, double r, double h) {
+  TriangleMesh m;
+  m.vertices.push_back(Vec3(0, 0, h));
+  m.vertices.push_back(Vec3(0, 0, -h));
+  for (int k = 0; k < segments; ++k) {
+    const double a = 2.0 * M_PI * k / segments;
+    m.vertices.push_back(Vec3(r * std::cos(a), r * std::sin(a), h));
+    m.vertices.push_back(Vec3(r * std::cos(a), r * std::sin(a), -h));
+  }
+  for (int k = 0; k < segments; ++k) {
+    const int t0 = 2 + 2 * k, b0 = t0 + 1, t1 = 2 + 2 * ((k + 1) % segments), b1 = t1 + 1;
+    m.faces.push_back({0, t0, t1});
+    m.faces.push_back({1, b1, b0});
+    m.faces.push_back({t0, b0, b1});
+    m.faces.push_back({t0, b1, t1});
+  }
+  return m;
+}
+
+TEST(FeatureChords, ACoarseCylindersRimChordsAreSplitOntoTheRimCircleKeepingTheTopology) {
+  const double r = 0.3, h = 0.2;
+  const MeshUdf udf(Cylinder(512, r, h), "fine cylinder");  // the rims: circles to within 3e-6 of r
+  // Chords of 60 degrees, their sagitta 0.13 x their length; they lie in the caps' planes, so only the
+  // sheets' planes, not the UDF at their midpoints, show them.
+  TriangleMesh mesh = Cylinder(6, r, h);
+  const TriangleMesh before = mesh;
+  ChordSplitOptions on;
+  on.enabled = true;
+  const ChordSplitStats st = SplitFeatureChords(udf, mesh, on, Monitor::Null());
+  // Sharp: the 12 rim edges and the 6 side edges between the prism's faces (60 degrees), which lie on the
+  // cylinder (their feature is themselves): chords, the rim edges only.
+  EXPECT_EQ(st.sharp, 18u);
+  EXPECT_EQ(st.chords, 12u);
+  EXPECT_EQ(st.split, 12u);
+  ASSERT_EQ(mesh.vertices.size(), before.vertices.size() + 12);
+  ASSERT_EQ(mesh.faces.size(), before.faces.size() + 24);
+  for (size_t v = before.vertices.size(); v < mesh.vertices.size(); ++v) {
+    const Vec3& p = mesh.vertices[v];
+    EXPECT_NEAR(std::hypot(p.x(), p.y()), r, 1e-4) << v;  // on the rim circle, not on the chord (0.87 r)
+    EXPECT_NEAR(std::abs(p.z()), h, 1e-4) << v;
+  }
+  const TopologyStats a = ComputeTopology(before), b = ComputeTopology(mesh);
+  EXPECT_EQ(b.euler, a.euler);
+  EXPECT_EQ(b.boundary_edges, 0u);
+  EXPECT_EQ(b.nonmanifold_edges, 0u);
+  // Orientation kept: the signed volume grows by the slivers added between chords and arcs.
+  auto volume = [](const TriangleMesh& m) {
+    double v = 0.0;
+    for (const Tri& t : m.faces) v += m.vertices[t[0]].dot(m.vertices[t[1]].cross(m.vertices[t[2]])) / 6.0;
+    return v;
+  };
+  EXPECT_GT(volume(mesh), volume(before));
+  // Off (the default): nothing changes; a mesh whose sharp edges are straight (the cube's) has no chords.
+  TriangleMesh same = before;
+  SplitFeatureChords(udf, same, ChordSplitOptions{}, Monitor::Null());
+  EXPECT_EQ(same.faces, before.faces);
+  const auto cube = MakeShape("cube");
+  TriangleMesh box = CubeGrid(4, 0.5);
+  const ChordSplitStats none = SplitFeatureChords(*cube, box, on, Monitor::Null());
+  EXPECT_GT(none.sharp, 0u);
+  EXPECT_EQ(none.chords, 0u);
 }
 
 TEST(Relax, ASpheresTrianglesEvenOutOnTheSphereWithTheSameFaces) {

@@ -47,6 +47,9 @@ int main(int argc, char** argv) {
   app.add_option("--relax-feature-angle", options.relax.feature_angle_deg,
                  "vertices on an edge whose faces' normals differ by more than this (deg) stay, as on rims "
                  "and non-manifold edges");
+  app.add_option("--split-feature-chords", options.chords.enabled,
+                 "before relaxing, split each sharp edge that cuts across a curved feature (the point where its "
+                 "two sheets' tangent planes meet lies over 10 % of its length off it) at that point (true/false)");
 
   return cli.Run(argc, argv, [&] { options.Check(); }, [&](voroudf::Monitor& monitor) {
     const auto udf = cli.OpenUdf(monitor);

@@ -531,7 +531,9 @@ TriangleMesh ThinMesh(const Udf& udf, const TriangleMesh& thick, const ThinMeshO
   out.vertices = thick.vertices;
   out.faces = oriented.faces();
   out = RemoveUnreferencedVertices(out);
-  // 7. Tangential relaxation: even triangles, the same connectivity, every vertex on the zero set.
+  // 7. Sharp edges that cut across a curved feature, split onto it (if asked); then tangential relaxation:
+  // even triangles (also round the split points), the same connectivity, every vertex on the zero set.
+  st.chords = SplitFeatureChords(udf, out, options.chords, monitor);
   st.relax = RelaxTangentially(udf, out, options.relax, monitor);
   monitor.Info(Count(out.vertices.size(), "vertices, ") + Count(out.faces.size(), "faces out"));
   if (stats_out) *stats_out = st;

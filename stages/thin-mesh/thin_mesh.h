@@ -9,6 +9,7 @@
 #include "common/types.h"
 #include "common/udf.h"
 #include "formats/mesh_io.h"
+#include "stages/thin-mesh/feature_chords.h"
 #include "stages/thin-mesh/relax.h"
 
 namespace voroudf {
@@ -41,6 +42,8 @@ struct ThinMeshOptions {
   int shell_rings = 1;
   /// Step 7, tangential relaxation (relax.h; --relax-iters, --relax-step, --relax-feature-angle).
   RelaxOptions relax;
+  /// Step 7, sharp-edge chords split onto their feature first (feature_chords.h; --split-feature-chords).
+  ChordSplitOptions chords;
 
   /// Throws UsageError for values that cannot work.
   void Check() const;
@@ -66,6 +69,7 @@ struct ThinMeshStats {
   size_t rim_flaps_removed = 0;     ///< step 6: flaps at a rim removed
   int rounds = 0;                   ///< rounds of (tetrahedra, components) until nothing changed
   RelaxStats relax;                 ///< step 7
+  ChordSplitStats chords;           ///< step 7, the chords
 };
 
 /// Thins a dual mesh (paper Sec. 3.4). Written by hand: no installed library handles triangle sets with
@@ -100,7 +104,9 @@ struct ThinMeshStats {
 ///     edge. Where a branching curve ends at the rims of its sheets, the regions of a rim seed of one sheet
 ///     and a seed of another meet at the curve's end, and the dual joins them by a face across the curve.
 ///  Manifold components are then oriented consistently, unreferenced vertices dropped (order kept).
-///  7. RelaxTangentially (relax.h), unless options.relax.iterations is 0: the vertices inside smooth manifold
+///  7. SplitFeatureChords (feature_chords.h), if options.chords.enabled: a sharp edge that cuts across a
+///     curved feature is split at the feature's point between its ends; the topology stays. Then
+///     RelaxTangentially (relax.h), unless options.relax.iterations is 0: the vertices inside smooth manifold
 ///     patches are evened out along the surface; the connectivity stays.
 ///
 /// \param udf    the field, for the centroid values
