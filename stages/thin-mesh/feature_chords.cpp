@@ -3,8 +3,10 @@
 #include <Eigen/Dense>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <string>
+#include <vector>
 
 #include "common/mesh_topology.h"
 
@@ -37,8 +39,13 @@ ChordSplitStats SplitFeatureChords(const Udf& udf, TriangleMesh& mesh, const Cho
   if (!options.enabled || mesh.faces.empty()) return st;
   const EdgeFaces ef = BuildEdgeFaces(mesh.faces);
   std::vector<Edge> sharp;
-  for (const Edge& e : FeatureEdges(mesh, ef, options.feature_angle_deg))
-    if (ef.faces[static_cast<size_t>(ef.Find(e[0], e[1]))].size() == 2) sharp.push_back(e);
+  for (const Edge& e : FeatureEdges(mesh, ef, options.feature_angle_deg)) {
+    const std::vector<int>& fs = ef.faces[static_cast<size_t>(ef.Find(e[0], e[1]))];
+    // Two faces, each with a third vertex (thin-mesh has dropped degenerate faces; this keeps it so here).
+    if (fs.size() == 2 && ThirdVertex(mesh.faces[static_cast<size_t>(fs[0])], e[0], e[1]) >= 0 &&
+        ThirdVertex(mesh.faces[static_cast<size_t>(fs[1])], e[0], e[1]) >= 0)
+      sharp.push_back(e);
+  }
   st.sharp = sharp.size();
   if (sharp.empty()) return st;
   const std::vector<Vec3>& x = mesh.vertices;
