@@ -622,7 +622,7 @@ TEST(FeatureChords, ACoarseCylindersRimChordsAreSplitOntoTheRimCircleKeepingTheT
   const TriangleMesh before = mesh;
   ChordSplitOptions on;
   on.enabled = true;
-  const ChordSplitStats st = SplitFeatureChords(udf, mesh, on, Monitor::Null());
+  const ChordSplitStats st = SplitFeatureChords(udf, mesh, on, 30.0, Monitor::Null());
   // Sharp: the 12 rim edges and the 6 side edges between the prism's faces (60 degrees), which lie on the
   // cylinder (their feature is themselves): chords, the rim edges only.
   EXPECT_EQ(st.sharp, 18u);
@@ -648,11 +648,11 @@ TEST(FeatureChords, ACoarseCylindersRimChordsAreSplitOntoTheRimCircleKeepingTheT
   EXPECT_GT(volume(mesh), volume(before));
   // Off (the default): nothing changes; a mesh whose sharp edges are straight (the cube's) has no chords.
   TriangleMesh same = before;
-  SplitFeatureChords(udf, same, ChordSplitOptions{}, Monitor::Null());
+  SplitFeatureChords(udf, same, ChordSplitOptions{}, 30.0, Monitor::Null());
   EXPECT_EQ(same.faces, before.faces);
   const auto cube = MakeShape("cube");
   TriangleMesh box = CubeGrid(4, 0.5);
-  const ChordSplitStats none = SplitFeatureChords(*cube, box, on, Monitor::Null());
+  const ChordSplitStats none = SplitFeatureChords(*cube, box, on, 30.0, Monitor::Null());
   EXPECT_GT(none.sharp, 0u);
   EXPECT_EQ(none.chords, 0u);
 }

@@ -124,8 +124,9 @@ const CellSamples& Optimizer::Analyze(SeedState& s, bool early) {
   cached_positions_ = s.position;
   // The cache keeps the field's own values and gradients (a kept cell is fitted afresh): sample planes are
   // changed on a copy. Without them the cache is the result, and megabytes are not copied on one thread.
-  if (fit_planes_ != 0 || centre_twin_planes_) planed_cells_ = cached_cells_;
-  CellSamples& cells = fit_planes_ != 0 || centre_twin_planes_ ? planed_cells_ : cached_cells_;
+  const bool planes_change = fit_planes_ != 0 || centre_twin_planes_;
+  if (planes_change) planed_cells_ = cached_cells_;
+  CellSamples& cells = planes_change ? planed_cells_ : cached_cells_;
   std::vector<char> fitted;
   if (fit_planes_ != 0) {
     SamplePlanes planes = FitSamplePlanes(cells, SamplePlaneFit{});

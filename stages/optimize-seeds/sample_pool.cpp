@@ -325,7 +325,7 @@ size_t SamplePool::Evaluate(const Udf& udf, const std::vector<PointId>& ids) {
   for (long lk = 0; lk < static_cast<long>(ask.size()); ++lk) {
     const size_t k = static_cast<size_t>(lk), v = base + k;
     Entry(ask[k]).value = static_cast<int32_t>(v);
-    value_blocks_[v >> kValueBlockBits][v & (block - 1)] = {d[k], g[k]};
+    Slot(v) = {d[k], g[k]};
   }
   return ask.size();
 }

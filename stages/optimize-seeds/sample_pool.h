@@ -127,9 +127,10 @@ class SamplePool {
   // on one thread at every doubling (a tenth of optimize-seeds' serial time on 2 threads); blocks are filled
   // in parallel and only appended.
   static constexpr int kValueBlockBits = 16;
+  static constexpr size_t kValueMask = (size_t{1} << kValueBlockBits) - 1;
+  Value& Slot(size_t v) { return value_blocks_[v >> kValueBlockBits][v & kValueMask]; }
   const Value& ValueOf(int32_t v) const {
-    const auto k = static_cast<size_t>(v);
-    return value_blocks_[k >> kValueBlockBits][k & ((size_t{1} << kValueBlockBits) - 1)];
+    return value_blocks_[static_cast<size_t>(v) >> kValueBlockBits][static_cast<size_t>(v) & kValueMask];
   }
   std::vector<std::unique_ptr<Value[]>> value_blocks_;
   size_t value_count_ = 0;

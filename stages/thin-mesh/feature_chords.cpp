@@ -34,17 +34,24 @@ std::array<Tri, 2> SplitFace(const Tri& t, int a, int b, int v) {
 }  // namespace
 
 ChordSplitStats SplitFeatureChords(const Udf& udf, TriangleMesh& mesh, const ChordSplitOptions& options,
-                                   Monitor& monitor) {
+                                   double feature_angle_deg, Monitor& monitor) {
   ChordSplitStats st;
   if (!options.enabled || mesh.faces.empty()) return st;
   const EdgeFaces ef = BuildEdgeFaces(mesh.faces);
-  std::vector<Edge> sharp;
-  for (const Edge& e : FeatureEdges(mesh, ef, options.feature_angle_deg)) {
+  // Each sharp manifold edge with its two faces and their third vertices, found once.
+  struct Sharp {
+    Edge edge;
+    std::array<int, 2> face, third;
+  };
+  std::vector<Sharp> sharp;
+  for (const Edge& e : FeatureEdges(mesh, ef, feature_angle_deg)) {
     const std::vector<int>& fs = ef.faces[static_cast<size_t>(ef.Find(e[0], e[1]))];
-    // Two faces, each with a third vertex (thin-mesh has dropped degenerate faces; this keeps it so here).
-    if (fs.size() == 2 && ThirdVertex(mesh.faces[static_cast<size_t>(fs[0])], e[0], e[1]) >= 0 &&
-        ThirdVertex(mesh.faces[static_cast<size_t>(fs[1])], e[0], e[1]) >= 0)
-      sharp.push_back(e);
+    if (fs.size() != 2) continue;
+    const Sharp c{e, {fs[0], fs[1]},
+                  {ThirdVertex(mesh.faces[static_cast<size_t>(fs[0])], e[0], e[1]),
+                   ThirdVertex(mesh.faces[static_cast<size_t>(fs[1])], e[0], e[1])}};
+    // Thin-mesh has dropped degenerate faces (a repeated vertex); this keeps it so here.
+    if (c.third[0] >= 0 && c.third[1] >= 0) sharp.push_back(c);
   }
   st.sharp = sharp.size();
   if (sharp.empty()) return st;
@@ -52,14 +59,12 @@ ChordSplitStats SplitFeatureChords(const Udf& udf, TriangleMesh& mesh, const Cho
   // One point on each side, a quarter of the edge into each face from the midpoint.
   std::vector<Vec3> mid(sharp.size()), side(2 * sharp.size());
   for (size_t k = 0; k < sharp.size(); ++k) {
-    const Vec3 a = x[static_cast<size_t>(sharp[k][0])], b = x[static_cast<size_t>(sharp[k][1])];
+    const Vec3 a = x[static_cast<size_t>(sharp[k].edge[0])], b = x[static_cast<size_t>(sharp[k].edge[1])];
     const double len = (b - a).norm();
     const Vec3 t = (b - a) / len;
     mid[k] = 0.5 * (a + b);
-    const std::vector<int>& fs = ef.faces[static_cast<size_t>(ef.Find(sharp[k][0], sharp[k][1]))];
     for (size_t j = 0; j < 2; ++j) {
-      const Vec3 c = x[static_cast<size_t>(ThirdVertex(mesh.faces[static_cast<size_t>(fs[j])], sharp[k][0], sharp[k][1]))];
-      Vec3 w = c - mid[k];
+      Vec3 w = x[static_cast<size_t>(sharp[k].third[j])] - mid[k];
       w -= w.dot(t) * t;
       side[2 * k + j] = mid[k] + 0.25 * len * (w.norm() > 0 ? Vec3(w.normalized()) : Vec3::Zero());
     }
@@ -73,15 +78,15 @@ ChordSplitStats SplitFeatureChords(const Udf& udf, TriangleMesh& mesh, const Cho
   std::vector<Vec3> feature;
   const double min_sin = std::sin(20.0 * M_PI / 180.0);
   for (size_t k = 0; k < sharp.size(); ++k) {
-    const Vec3 a = x[static_cast<size_t>(sharp[k][0])], b = x[static_cast<size_t>(sharp[k][1])];
+    const Vec3 a = x[static_cast<size_t>(sharp[k].edge[0])], b = x[static_cast<size_t>(sharp[k].edge[1])];
     const Vec3 t = (b - a).normalized();
     const Vec3 n0 = g_side[2 * k], n1 = g_side[2 * k + 1];
     if (n0.squaredNorm() < 0.25 || n1.squaredNorm() < 0.25 || n0.normalized().cross(n1.normalized()).norm() < min_sin)
       continue;
     // Each face must lie along its sheet (normals within 30 degrees): otherwise the edge is not between the
     // two sheets of a feature but across a part the mesh does not follow.
-    const std::vector<int>& fs = ef.faces[static_cast<size_t>(ef.Find(sharp[k][0], sharp[k][1]))];
-    const Vec3 m0 = AreaNormal(x, mesh.faces[static_cast<size_t>(fs[0])]), m1 = AreaNormal(x, mesh.faces[static_cast<size_t>(fs[1])]);
+    const Vec3 m0 = AreaNormal(x, mesh.faces[static_cast<size_t>(sharp[k].face[0])]);
+    const Vec3 m1 = AreaNormal(x, mesh.faces[static_cast<size_t>(sharp[k].face[1])]);
     if (std::abs(m0.normalized().dot(n0.normalized())) < kAlongSheetCos ||
         std::abs(m1.normalized().dot(n1.normalized())) < kAlongSheetCos)
       continue;
@@ -106,13 +111,13 @@ ChordSplitStats SplitFeatureChords(const Udf& udf, TriangleMesh& mesh, const Cho
   for (size_t i = 0; i < which.size(); ++i) {
     const size_t k = which[i];
     if (!(d_feature[i] <= 0.25 * (feature[i] - mid[k]).norm())) continue;  // the planes' point is on the surface
-    const std::vector<int>& fs = ef.faces[static_cast<size_t>(ef.Find(sharp[k][0], sharp[k][1]))];
+    const std::array<int, 2>& fs = sharp[k].face;
     if (touched[static_cast<size_t>(fs[0])] || touched[static_cast<size_t>(fs[1])]) continue;
     const int v = static_cast<int>(mesh.vertices.size());
     mesh.vertices.push_back(feature[i]);
     for (int f : fs) {
       touched[static_cast<size_t>(f)] = 1;
-      const std::array<Tri, 2> two = SplitFace(mesh.faces[static_cast<size_t>(f)], sharp[k][0], sharp[k][1], v);
+      const std::array<Tri, 2> two = SplitFace(mesh.faces[static_cast<size_t>(f)], sharp[k].edge[0], sharp[k].edge[1], v);
       mesh.faces[static_cast<size_t>(f)] = two[0];
       mesh.faces.push_back(two[1]);
     }

@@ -15,7 +15,6 @@ namespace voroudf {
 
 struct ChordSplitOptions {
   bool enabled = false;             ///< --split-feature-chords (off: it trades triangle quality and vertices for CD)
-  double feature_angle_deg = 30.0;  ///< an edge is sharp when its faces' normals differ by more (evaluate's)
   double sagitta_rel = 0.1;         ///< split when the feature lies farther than this x the edge's length from it
 };
 
@@ -34,7 +33,9 @@ struct ChordSplitStats {
 /// Invariant: an edge split on a manifold edge adds one vertex, three edges and two faces, so the Euler
 /// characteristic, the boundary and the non-manifold edges are the input's; face orientation is kept.
 /// \param mesh  vertices on the zero set of `udf`
+/// \param feature_angle_deg  an edge is sharp when its faces' normals differ by more (the relaxation's angle,
+///        so that the split points are vertices the relaxation keeps in place)
 ChordSplitStats SplitFeatureChords(const Udf& udf, TriangleMesh& mesh, const ChordSplitOptions& options,
-                                   Monitor& monitor);
+                                   double feature_angle_deg, Monitor& monitor);
 
 }  // namespace voroudf

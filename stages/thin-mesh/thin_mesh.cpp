@@ -533,7 +533,7 @@ TriangleMesh ThinMesh(const Udf& udf, const TriangleMesh& thick, const ThinMeshO
   out = RemoveUnreferencedVertices(out);
   // 7. Sharp edges that cut across a curved feature, split onto it (if asked); then tangential relaxation:
   // even triangles (also round the split points), the same connectivity, every vertex on the zero set.
-  st.chords = SplitFeatureChords(udf, out, options.chords, monitor);
+  st.chords = SplitFeatureChords(udf, out, options.chords, options.relax.feature_angle_deg, monitor);
   st.relax = RelaxTangentially(udf, out, options.relax, monitor);
   monitor.Info(Count(out.vertices.size(), "vertices, ") + Count(out.faces.size(), "faces out"));
   if (stats_out) *stats_out = st;
