@@ -6,8 +6,11 @@
 #
 # Usage: pipelines/voroudf.sh --udf SPEC -o DIR [--count N] [--seed S] [--threads T] [--reference MESH]
 #            [--sample-seeds "ARGS"] [--optimize-seeds "ARGS"] [--build-gvd "ARGS"] [--thin-mesh "ARGS"]
-#            [--evaluate "ARGS"] [--from STAGE]
+#            [--evaluate "ARGS"] [--from STAGE] [--fast]
 #   --STAGE "ARGS"  extra options for that stage (split on spaces), e.g. --optimize-seeds "--gamma 5"
+#   --fast          0.55-0.65x the time and UDF queries, rougher meshes: optimize-seeds gets
+#                   --samples-per-cell 60 --repulsion-cells first, build-gvd --samples-per-seed 100
+#                   (docs/performance.md, "A faster chain"); those options cannot be given again
 #   --from STAGE    start at this stage (optimize-seeds, build-gvd or thin-mesh), with the earlier stages'
 #                   files already in DIR: to try one stage's options or program on the same input
 #   --reference     also run evaluate against this mesh -> DIR/metrics.json
@@ -22,8 +25,8 @@ BUILD_GVD=${VOROUDF_BUILD_GVD:-$BIN/build-gvd}
 THIN_MESH=${VOROUDF_THIN_MESH:-$BIN/thin-mesh}
 EVALUATE=${VOROUDF_EVALUATE:-$BIN/evaluate}
 
-usage() { sed -n '7,15p' "${BASH_SOURCE[0]}" | sed 's/^# \{0,1\}//' >&2; exit "${1:-2}"; }
-UDF="" OUT="" COUNT=3000 SEED=0 THREADS=0 REF="" FROM=sample-seeds
+usage() { sed -n '7,18p' "${BASH_SOURCE[0]}" | sed 's/^# \{0,1\}//' >&2; exit "${1:-2}"; }
+UDF="" OUT="" COUNT=3000 SEED=0 THREADS=0 REF="" FROM=sample-seeds FAST=0
 A_SAMPLE="" A_OPT="" A_GVD="" A_THIN="" A_EVAL=""
 while (($#)); do
   case "$1" in
@@ -39,11 +42,17 @@ while (($#)); do
     --thin-mesh) A_THIN=$2; shift 2 ;;
     --evaluate) A_EVAL=$2; shift 2 ;;
     --from) FROM=$2; shift 2 ;;
+    --fast) FAST=1; shift ;;
     -h|--help) usage 0 ;;
     *) echo "$0: unknown option '$1'" >&2; usage ;;
   esac
 done
 [ -n "$UDF" ] && [ -n "$OUT" ] || usage
+# The fast setting: fewer samples per cell, the cells drawn once per outer iteration, a sparser graph.
+if [ "$FAST" = 1 ]; then
+  A_OPT="--samples-per-cell 60 --repulsion-cells first $A_OPT"
+  A_GVD="--samples-per-seed 100 $A_GVD"
+fi
 # The stages in order, and the file each reads from DIR.
 STAGES=(sample-seeds optimize-seeds build-gvd thin-mesh)
 declare -A INPUT=([optimize-seeds]=seeds0.ply [build-gvd]=seeds.ply [thin-mesh]=thick.ply)

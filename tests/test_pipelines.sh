@@ -56,6 +56,22 @@ case "$WHAT" in
     set -e
     [ "$rc" = 3 ] || fail "a bad --udf should end the chain with exit 3, got $rc"
     [ ! -e "$TMP/d/seeds0.ply" ] || fail "a failed stage left a file"
+    # --fast: the stages run with the fast setting (each file's header records its options) and fewer UDF
+    # queries than the default chain on the same input; an option of the setting given again is refused.
+    bash "$ROOT/pipelines/voroudf.sh" --udf shape:sphere -o "$TMP/g" --count 500 --seed 3 --fast 2> /dev/null
+    grep -a -m1 "^comment options" "$TMP/g/seeds.ply" | grep -q -- "--samples-per-cell 60 .*--repulsion-cells first" ||
+      fail "--fast: optimize-seeds ran without the fast setting"
+    grep -a -m1 "^comment options" "$TMP/g/thick.ply" | grep -q -- "--samples-per-seed 100" ||
+      fail "--fast: build-gvd ran without the fast setting"
+    queries() { awk -F'\t' 'NR > 1 { q += $3 } END { print q }' "$1/timings.tsv"; }
+    [ "$(queries "$TMP/g")" -lt "$(queries "$TMP/a")" ] ||
+      fail "--fast asked no fewer UDF queries: $(queries "$TMP/g") against $(queries "$TMP/a")"
+    set +e
+    bash "$ROOT/pipelines/voroudf.sh" --udf shape:sphere -o "$TMP/h" --count 300 --fast \
+      --build-gvd "--samples-per-seed 150" 2> "$TMP/err"
+    rc=$?
+    set -e
+    [ "$rc" = 2 ] && grep -q -- "--samples-per-seed" "$TMP/err" || fail "--fast with its option again: exit $rc"
     ;;
   make)
     make -s -f "$ROOT/Makefile.example" -C "$TMP" -j2 VOROUDF_BIN="$BIN" SHAPES="sphere disc" COUNT=400 OUT=out \
