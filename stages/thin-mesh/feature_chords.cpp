@@ -56,17 +56,19 @@ ChordSplitStats SplitFeatureChords(const Udf& udf, TriangleMesh& mesh, const Cho
   st.sharp = sharp.size();
   if (sharp.empty()) return st;
   const std::vector<Vec3>& x = mesh.vertices;
-  // One point on each side, a quarter of the edge into each face from the midpoint.
-  std::vector<Vec3> mid(sharp.size()), side(2 * sharp.size());
+  // One point on each side, a quarter of the edge into each face from the midpoint; each edge's midpoint,
+  // unit direction and length, kept for the solve below.
+  std::vector<Vec3> mid(sharp.size()), dir(sharp.size()), side(2 * sharp.size());
+  std::vector<double> len(sharp.size());
   for (size_t k = 0; k < sharp.size(); ++k) {
     const Vec3 a = x[static_cast<size_t>(sharp[k].edge[0])], b = x[static_cast<size_t>(sharp[k].edge[1])];
-    const double len = (b - a).norm();
-    const Vec3 t = (b - a) / len;
+    len[k] = (b - a).norm();
+    dir[k] = (b - a) / len[k];
     mid[k] = 0.5 * (a + b);
     for (size_t j = 0; j < 2; ++j) {
       Vec3 w = x[static_cast<size_t>(sharp[k].third[j])] - mid[k];
-      w -= w.dot(t) * t;
-      side[2 * k + j] = mid[k] + 0.25 * len * (w.norm() > 0 ? Vec3(w.normalized()) : Vec3::Zero());
+      w -= w.dot(dir[k]) * dir[k];
+      side[2 * k + j] = mid[k] + 0.25 * len[k] * (w.norm() > 0 ? Vec3(w.normalized()) : Vec3::Zero());
     }
   }
   std::vector<double> d_side;
@@ -78,8 +80,7 @@ ChordSplitStats SplitFeatureChords(const Udf& udf, TriangleMesh& mesh, const Cho
   std::vector<Vec3> feature;
   const double min_sin = std::sin(20.0 * M_PI / 180.0);
   for (size_t k = 0; k < sharp.size(); ++k) {
-    const Vec3 a = x[static_cast<size_t>(sharp[k].edge[0])], b = x[static_cast<size_t>(sharp[k].edge[1])];
-    const Vec3 t = (b - a).normalized();
+    const Vec3& t = dir[k];
     const Vec3 n0 = g_side[2 * k], n1 = g_side[2 * k + 1];
     if (n0.squaredNorm() < 0.25 || n1.squaredNorm() < 0.25 || n0.normalized().cross(n1.normalized()).norm() < min_sin)
       continue;
@@ -96,8 +97,8 @@ ChordSplitStats SplitFeatureChords(const Udf& udf, TriangleMesh& mesh, const Cho
     m.row(1) = n1.transpose();
     m.row(2) = t.transpose();
     const Vec3 p = m.colPivHouseholderQr().solve(Vec3(n0.dot(f0), n1.dot(f1), t.dot(mid[k])));
-    const double off = (p - mid[k]).norm(), len = (b - a).norm();
-    if (!p.allFinite() || !(off > options.sagitta_rel * len) || off > 0.5 * len) continue;
+    const double off = (p - mid[k]).norm();
+    if (!p.allFinite() || !(off > options.sagitta_rel * len[k]) || off > 0.5 * len[k]) continue;
     ++st.chords;
     which.push_back(k);
     feature.push_back(p);
