@@ -20,6 +20,13 @@ inline uint64_t EdgeKey(const Edge& e) {
   return (static_cast<uint64_t>(static_cast<uint32_t>(e[0])) << 32) | static_cast<uint32_t>(e[1]);
 }
 
+/// The vertex of face t that is neither a nor b; -1 if there is none (a face that repeats a vertex).
+inline int ThirdVertex(const Tri& t, int a, int b) {
+  for (int v : t)
+    if (v != a && v != b) return v;
+  return -1;
+}
+
 /// The vertex triple in increasing order: the key of "the same three vertices" in any orientation.
 inline Tri SortedTri(Tri t) {
   if (t[0] > t[1]) std::swap(t[0], t[1]);

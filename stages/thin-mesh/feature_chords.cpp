@@ -15,13 +15,6 @@ namespace {
 
 const double kAlongSheetCos = std::cos(30.0 * M_PI / 180.0);
 
-// The vertex of face t that is neither a nor b.
-int ThirdVertex(const Tri& t, int a, int b) {
-  for (int v : t)
-    if (v != a && v != b) return v;
-  return -1;
-}
-
 // Face t with edge (a, b) replaced by (a, v) and (v, b), orientation kept: two faces.
 std::array<Tri, 2> SplitFace(const Tri& t, int a, int b, int v) {
   for (int k = 0; k < 3; ++k) {

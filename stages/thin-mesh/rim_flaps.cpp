@@ -128,7 +128,7 @@ size_t RemoveFoldedFlaps(const std::vector<Vec3>& v, std::vector<Tri>& faces, do
   auto away = [&](int f, const Edge& ab) {  // from edge ab towards face f's third vertex
     const Tri& t = faces[static_cast<size_t>(f)];
     const Vec3 a = v[static_cast<size_t>(ab[0])], axis = (v[static_cast<size_t>(ab[1])] - a).normalized();
-    return AcrossLine(a, axis, v[static_cast<size_t>(t[0] + t[1] + t[2] - ab[0] - ab[1])]);
+    return AcrossLine(a, axis, v[static_cast<size_t>(ThirdVertex(t, ab[0], ab[1]))]);
   };
   size_t removed = 0;
   for (size_t f = 0; f < faces.size(); ++f) {

@@ -261,7 +261,7 @@ class Thinner {
       const Vec3 a = p[static_cast<size_t>(ab[0])], axis = (p[static_cast<size_t>(ab[1])] - a).normalized();
       auto away = [&](int f) {  // from the edge towards the face's third vertex
         const Tri& t = faces_[static_cast<size_t>(f)];
-        return AcrossLine(a, axis, p[static_cast<size_t>(t[0] + t[1] + t[2] - ab[0] - ab[1])]);
+        return AcrossLine(a, axis, p[static_cast<size_t>(ThirdVertex(t, ab[0], ab[1]))]);
       };
       for (int f : incidence_.faces[static_cast<size_t>(e)]) {
         if (!alive_[static_cast<size_t>(f)] || !in.count(f)) continue;
