@@ -1230,7 +1230,10 @@ TEST(OptimizeSeeds, ChordsOffTheTangentsBisectorJoinTwoCurves) {
 
 // A plate whose edge faces are half a spacing wide: each of its 8 long rims gets its own chain of curve
 // seeds (no gap over 2.5 spacings). Without the two-curve rule the rims of one edge face crowd each other
-// out and share one chain, with gaps of several spacings on each.
+// out and share one chain, with gaps of several spacings on each. Three draws, of which two must pass: the
+// optimizer is chaotic at this scale (an L1 step differing by 1e-6 of the diagonal gives another draw), and
+// about one draw in eight leaves one gap of ~3 spacings on one rim (with the rule: 1.5 in 7 of draws 1-8; without:
+// 5.8-12 in all).
 std::unique_ptr<MeshUdf> SlabUdf(double thickness) {
   TriangleMesh m;
   m.vertices = {Vec3(-1, -1, 0), Vec3(1, -1, 0), Vec3(1, 1, 0), Vec3(-1, 1, 0),
@@ -1243,8 +1246,7 @@ std::unique_ptr<MeshUdf> SlabUdf(double thickness) {
 TEST(OptimizeSeeds, BothRimsOfANarrowEdgeFaceGetAChain) {
   const double thickness = 0.03;
   const auto udf = SlabUdf(thickness);
-  const SeedCloud in = Initial(*udf, 800, 1);
-  auto widest_gap = [&](double curve_separation) {
+  auto widest_gap = [&](const SeedCloud& in, double curve_separation) {
     OptimizeSeedsOptions options;
     options.curve_separation = curve_separation;
     const SeedCloud out = OptimizeSeeds(*udf, in, options, Monitor::Null());
@@ -1266,8 +1268,13 @@ TEST(OptimizeSeeds, BothRimsOfANarrowEdgeFaceGetAChain) {
         }
     return widest;
   };
-  EXPECT_LT(widest_gap(0.45), 2.5);
-  EXPECT_GT(widest_gap(0.0), 4.0) << "the test needs rims that share a chain without the rule";
+  int chained = 0;
+  for (uint64_t draw = 1; draw <= 3; ++draw) {
+    const SeedCloud in = Initial(*udf, 800, draw);
+    chained += widest_gap(in, 0.45) < 2.5;
+    EXPECT_GT(widest_gap(in, 0.0), 4.0) << "the test needs rims that share a chain without the rule";
+  }
+  EXPECT_GE(chained, 2);
 }
 
 // The stopping rules fire before the caps: the inner loop at the first round whose projected gradient

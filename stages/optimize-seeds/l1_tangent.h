@@ -36,7 +36,7 @@ struct L1TangentOptions {
   /// Stop once the duality gap P(y) − D(u, λ) ≤ gap_tolerance. Since P is 2γ-strongly convex,
   /// ‖y − y*‖ ≤ sqrt(gap / γ): set gap_tolerance = γ·ε² for a position error of ε (relative units).
   double gap_tolerance = 1e-11;
-  int max_newton_steps = 200;  ///< barrier method: Newton steps in total before giving up on the gap
+  int max_newton_steps = 200;  ///< interior-point iterations before giving up on the gap
   int max_sweeps = 2000;       ///< coordinate ascent: cyclic passes over the dual coordinates
   /// Coordinate ascent: projected successive over-relaxation factor ω ∈ (0, 2) (ω = 1: plain ascent);
   /// projected SOR on a box-constrained concave QP converges for any ω in (0, 2) (Mangasarian 1977).
@@ -47,7 +47,7 @@ struct L1TangentSolution {
   Vec3 y = Vec3::Zero();  ///< feasible minimiser (within the gap tolerance)
   double primal = 0.0;    ///< P(y)
   double dual = 0.0;      ///< D(u, λ) ≤ P(y*) ≤ P(y)
-  int sweeps = 0;         ///< Newton steps (barrier) or sweeps (coordinate ascent)
+  int sweeps = 0;         ///< interior-point iterations, or sweeps (coordinate ascent)
   bool converged = false; ///< gap ≤ tolerance; if false, y is still feasible and P(y) ≤ P(0)
 };
 
@@ -57,13 +57,13 @@ struct L1TangentSolution {
 /// Every such (u, λ) gives a lower bound D ≤ min P: the certificate both solvers stop on.
 double L1TangentDual(const L1TangentProblem& problem, const std::vector<double>& u, const std::vector<double>& lambda);
 
-/// Solves the problem exactly up to a certified duality gap with a primal barrier (interior-point)
-/// method on the smooth equivalent  min Σ w_m t_m + γ‖y‖²  s.t.  −t_m ≤ a_mᵀy − b_m ≤ t_m,  c_kᵀy ≤ h_k
-/// (Boyd & Vandenberghe, Convex Optimization, Sec. 11.3): damped Newton centring, barrier weight ×20 per
-/// stage. Eliminating the t-block (diagonal) reduces every Newton system to 3×3, so a step costs O(M + K).
-/// After each stage the central path's multipliers u_m = z⁺_m − z⁻_m (clipped to [−w_m, w_m]) and
-/// λ_k = 1/(τ s_k) give a dual point; the stage's y is strictly feasible; the solver stops when
-/// P(y) − D(u, λ) ≤ gap_tolerance. It returns the best feasible y seen, never worse than y = 0.
+/// Solves the problem exactly up to a certified duality gap with Mehrotra's predictor-corrector primal-dual
+/// interior-point method (Nocedal & Wright, Numerical Optimization, Sec. 16.6) on the smooth equivalent
+/// min Σ w_m t_m + γ‖y‖²  s.t.  −t_m ≤ a_mᵀy − b_m ≤ t_m,  c_kᵀy ≤ h_k. The slacks are functions of (y, t), so
+/// the iterate stays strictly feasible; eliminating the t-block and the multipliers reduces each Newton
+/// system to 3×3 (one factorisation, two right-hand sides per iteration), so an iteration costs O(M + K).
+/// The multipliers give a dual point u_m = z⁺_m − z⁻_m (clipped to [−w_m, w_m]), λ_k ≥ 0; the solver stops
+/// when P(y) − D(u, λ) ≤ gap_tolerance. It returns the best feasible y seen, never worse than y = 0.
 /// \pre gamma > 0; every h_k > 0; a_m and c_k unit vectors.
 L1TangentSolution SolveL1Tangent(const L1TangentProblem& problem, const L1TangentOptions& options);
 

@@ -50,7 +50,7 @@ int main(int argc, char** argv) {
   app.add_option("--repulsion-cutoff", o.repulsion_cutoff, "seeds repel within this many kernel widths");
   app.add_option("--l1-tol-rel", o.l1_tol_rel, "L1 step position accuracy (certified by the duality gap), relative");
   app.add_option("--l1-curve-step", o.l1_curve_step, "free: a curve seed's L1 step moves it in every direction (the paper); across: only across its curve unless its cell sees a corner; auto: across on a field with a floor (value errors), free on an exact one");
-  app.add_option("--l1-max-steps", o.l1_max_steps, "Newton steps of the L1 step's interior-point solver");
+  app.add_option("--l1-max-steps", o.l1_max_steps, "iterations of the L1 step's interior-point solver");
   app.add_option("--move-tol", o.move_tol, "an inner loop moving no seed farther than this many kernel widths ends it");
   app.add_option("--outer-tol", o.outer_tol, "outer loop ends when the spacing CV improves by less than this, relatively");
   app.add_option("--proj-tol-rel", o.proj_tol_rel, "projection tolerance on d, relative to the diagonal");

@@ -84,7 +84,7 @@ struct OptimizeSeedsOptions {
   /// field. Not in the paper, see docs/optimize-seeds.md ("Curve seeds step across their curve").
   std::string l1_curve_step = "across";
   double l1_tol_rel = 1e-6;       ///< L1 step solved to this position accuracy, relative to the diagonal (--l1-tol-rel)
-  int l1_max_steps = 200;         ///< Newton steps of the L1 step's barrier method before it gives up (--l1-max-steps)
+  int l1_max_steps = 200;         ///< iterations of the L1 step's interior-point method before it gives up (--l1-max-steps)
   double move_tol = 1e-3;         ///< an inner loop moving no seed farther than move_tol·σ "makes no update" (--move-tol)
   double outer_tol = 0.02;        ///< outer loop ends when σ does not grow and the spacing CV drops by less than this, relatively (--outer-tol)
   double proj_tol_rel = 1e-5;     ///< projection tolerance on d, relative to the diagonal (as sample-seeds) (--proj-tol-rel)

@@ -267,7 +267,7 @@ std::vector<Vec3> Optimizer::L1Step(const SeedState& s, const CellSamples& cells
   }
   const size_t failed = std::count(converged.begin(), converged.end(), 0);
   const double mean_sweeps = std::accumulate(sweeps.begin(), sweeps.end(), 0.0) / static_cast<double>(n);
-  monitor_.Debug(Format("L1 step: %.1f Newton steps per seed on average", mean_sweeps));
+  monitor_.Debug(Format("L1 step: %.1f interior-point iterations per seed on average", mean_sweeps));
   if (failed > 0)
     monitor_.Debug(std::to_string(failed) + " L1 steps hit --l1-max-steps before the gap certificate "
                    "(their best feasible point is used)");
