@@ -175,12 +175,13 @@ class KktSystem {
  public:
   KktSystem(const L1TangentProblem& p, const PrimalDual& x, const std::vector<double>& sp, const std::vector<double>& sm,
             const std::vector<double>& sc)
-      : p_(p), x_(x), sp_(sp), sm_(sm), sc_(sc), e_(p.a.size()) {
+      : p_(p), x_(x), sp_(sp), sm_(sm), sc_(sc), dp_(p.a.size()), dm_(p.a.size()), beta_(p.a.size()) {
     Eigen::Matrix3d h = 2.0 * p.gamma * Eigen::Matrix3d::Identity();
     for (size_t m = 0; m < p.a.size(); ++m) {
       const double dp = x.zp[m] / sp[m], dm = x.zm[m] / sm[m];
-      e_[m] = 4.0 * dp * dm / (dp + dm);
-      h += e_[m] * (p.a[m] * p.a[m].transpose());
+      dp_[m] = dp;
+      dm_[m] = dm;
+      h += (4.0 * dp * dm / (dp + dm)) * (p.a[m] * p.a[m].transpose());
     }
     for (size_t k = 0; k < p.c.size(); ++k) h += (x.lambda[k] / sc[k]) * (p.c[k] * p.c[k].transpose());
     // Stationarity in y: 2γ y + Σ (zp − zm) a + Σ λ c.
@@ -199,21 +200,19 @@ class KktSystem {
     d.dlambda.resize(kc);
     Vec3 rhs = -residual_y_;
     for (size_t m = 0; m < mc; ++m) {
-      const double dp = x_.zp[m] / sp_[m], dm = x_.zm[m] / sm_[m], s = dp + dm;
+      const double dp = dp_[m], dm = dm_[m], s = dp + dm;
       const double ap = rp[m] / sp_[m], am = rm[m] / sm_[m];
-      const double beta = ap + am - (Weight(p_, m) - x_.zp[m] - x_.zm[m]);  // stationarity in t: w − zp − zm
-      rhs -= (ap - am - (dp - dm) * beta / s) * p_.a[m];
+      beta_[m] = ap + am - (Weight(p_, m) - x_.zp[m] - x_.zm[m]);  // stationarity in t: w − zp − zm
+      rhs -= (ap - am - (dp - dm) * beta_[m] / s) * p_.a[m];
     }
     for (size_t k = 0; k < kc; ++k) rhs -= (rc[k] / sc_[k]) * p_.c[k];
     d.dy = ldlt_.solve(rhs);
     for (size_t m = 0; m < mc; ++m) {
-      const double dp = x_.zp[m] / sp_[m], dm = x_.zm[m] / sm_[m], s = dp + dm;
-      const double ap = rp[m] / sp_[m], am = rm[m] / sm_[m];
-      const double beta = ap + am - (Weight(p_, m) - x_.zp[m] - x_.zm[m]);
+      const double dp = dp_[m], dm = dm_[m];
       const double q = p_.a[m].dot(d.dy);
-      d.dt[m] = (beta + (dp - dm) * q) / s;
-      d.dzp[m] = ap - dp * (d.dt[m] - q);
-      d.dzm[m] = am - dm * (d.dt[m] + q);
+      d.dt[m] = (beta_[m] + (dp - dm) * q) / (dp + dm);
+      d.dzp[m] = rp[m] / sp_[m] - dp * (d.dt[m] - q);
+      d.dzm[m] = rm[m] / sm_[m] - dm * (d.dt[m] + q);
     }
     for (size_t k = 0; k < kc; ++k) d.dlambda[k] = (rc[k] + x_.lambda[k] * p_.c[k].dot(d.dy)) / sc_[k];
   }
@@ -242,7 +241,8 @@ class KktSystem {
   const L1TangentProblem& p_;
   const PrimalDual& x_;
   const std::vector<double>&sp_, &sm_, &sc_;
-  std::vector<double> e_;
+  std::vector<double> dp_, dm_;         // z⁺/s⁺ and z⁻/s⁻ at the iterate
+  mutable std::vector<double> beta_;    // Solve's scratch: the t-row's right-hand side, reused by its second pass
   Vec3 residual_y_;
   Eigen::LDLT<Eigen::Matrix3d> ldlt_;
 };
