@@ -62,8 +62,9 @@ std::vector<int> KNearestAmong(const std::vector<Vec3>& points, int k, int* k_ou
     flann::Matrix<size_t> mi(idx.data(), m, static_cast<size_t>(kq));
     flann::Matrix<float> md(dist.data(), m, static_cast<size_t>(kq));
     tree.index->knnSearch(queries, mi, md, static_cast<size_t>(kq), params);
-    for (size_t q = 0; q < m; ++q) {
-      const size_t self = begin + q;
+#pragma omp parallel for schedule(static)
+    for (long lq = 0; lq < static_cast<long>(m); ++lq) {
+      const size_t q = static_cast<size_t>(lq), self = begin + q;
       int filled = 0;
       for (int j = 0; j < kq && filled < kk; ++j) {
         const size_t other = mi[q][static_cast<size_t>(j)];

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <utility>
 
 namespace voroudf {
@@ -20,6 +21,12 @@ uint64_t Spread21(uint64_t x) {
   return x;
 }
 
+struct Keyed {
+  uint64_t code;
+  size_t index;
+  bool operator<(const Keyed& o) const { return code < o.code || (code == o.code && index < o.index); }
+};
+
 }  // namespace
 
 uint64_t MortonCode(const Vec3& p, const Box& box) {
@@ -34,26 +41,61 @@ uint64_t MortonCode(const Vec3& p, const Box& box) {
 }
 
 std::vector<size_t> MortonOrder(const Vec3* points, size_t count, const Box& box) {
-  std::vector<std::pair<uint64_t, size_t>> keyed(count);
+  // Plain arrays, left uninitialised: their pages are first touched by the threads that fill them.
+  const std::unique_ptr<Keyed[]> keyed(new Keyed[count]);
 #pragma omp parallel for schedule(static)
-  for (long i = 0; i < static_cast<long>(count); ++i) keyed[i] = {MortonCode(points[i], box), i};
-  // Large batches are sorted on every thread (the sort is 5 % of optimize-seeds on one): one slice per
-  // thread, then pairwise merges. Keys are unique (the index breaks ties), so the order is std::sort's
-  // whatever the thread count. By hand: libstdc++'s parallel mode (__gnu_parallel::sort) does the same but
-  // has a data race of its own that ThreadSanitizer reports (every thread writes its thread count).
-  const int parts = count >= 65536 && !omp_in_parallel() ? std::min(omp_get_max_threads(), 64) : 1;
-  std::vector<size_t> bound(static_cast<size_t>(parts) + 1);
-  for (int k = 0; k <= parts; ++k) bound[static_cast<size_t>(k)] = count * static_cast<size_t>(k) / static_cast<size_t>(parts);
-  const auto at = [&](int k) { return keyed.begin() + static_cast<long>(bound[static_cast<size_t>(k)]); };
-#pragma omp parallel for schedule(static) if (parts > 1)
-  for (int k = 0; k < parts; ++k) std::sort(at(k), at(k + 1));
-  for (int width = 1; width < parts; width *= 2) {
-#pragma omp parallel for schedule(static) if (parts > 1)
-    for (int k = 0; k < parts; k += 2 * width)
-      if (k + width < parts) std::inplace_merge(at(k), at(k + width), at(std::min(k + 2 * width, parts)));
-  }
+  for (long i = 0; i < static_cast<long>(count); ++i) keyed[i] = {MortonCode(points[i], box), static_cast<size_t>(i)};
   std::vector<size_t> order(count);
-  for (size_t i = 0; i < count; ++i) order[i] = keyed[i].second;
+  // Batches from a few thousand points on are sorted on every thread (a serial sort was a tenth of
+  // optimize-seeds' serial time on two threads): bucketed by the codes' leading bits, chunk by chunk, then
+  // every bucket sorted on its own. Keys are unique (the index breaks ties), so the order is std::sort's
+  // whatever the threads. By hand: libstdc++'s parallel mode (__gnu_parallel::sort) does the same but has a
+  // data race of its own that ThreadSanitizer reports (every thread writes its thread count).
+  if (count < 4096 || omp_in_parallel() || omp_get_max_threads() == 1) {
+    std::sort(keyed.get(), keyed.get() + count);
+    for (size_t i = 0; i < count; ++i) order[i] = keyed[i].index;
+    return order;
+  }
+  uint64_t lo = ~uint64_t{0}, hi = 0;
+#pragma omp parallel for schedule(static) reduction(min : lo) reduction(max : hi)
+  for (long i = 0; i < static_cast<long>(count); ++i) {
+    lo = std::min(lo, keyed[i].code);
+    hi = std::max(hi, keyed[i].code);
+  }
+  // Up to 4,096 buckets of the code range; at most 16 chunks of the input count their buckets (chunks fixed
+  // by the count, not the threads, so that the scatter is the same for any team).
+  const size_t want_buckets = std::min<size_t>(4096, count / 8);
+  int shift = 0;
+  while (((hi - lo) >> shift) >= want_buckets) ++shift;
+  const size_t buckets = static_cast<size_t>((hi - lo) >> shift) + 1;
+  const auto bucket_of = [&](uint64_t code) { return static_cast<size_t>((code - lo) >> shift); };
+  const size_t chunks = std::min<size_t>(16, (count + 4095) / 4096), chunk = (count + chunks - 1) / chunks;
+  std::vector<size_t> at(chunks * buckets, 0);  // per chunk and bucket: its count, then where it writes
+#pragma omp parallel for schedule(static)
+  for (long c = 0; c < static_cast<long>(chunks); ++c)
+    for (size_t i = static_cast<size_t>(c) * chunk; i < std::min(count, (static_cast<size_t>(c) + 1) * chunk); ++i)
+      ++at[static_cast<size_t>(c) * buckets + bucket_of(keyed[i].code)];
+  std::vector<size_t> bucket_begin(buckets + 1, 0);
+  for (size_t b = 0, total = 0; b < buckets; ++b) {
+    bucket_begin[b] = total;
+    for (size_t c = 0; c < chunks; ++c) {
+      const size_t n = at[c * buckets + b];
+      at[c * buckets + b] = total;
+      total += n;
+    }
+  }
+  bucket_begin[buckets] = count;
+  const std::unique_ptr<Keyed[]> sorted(new Keyed[count]);
+#pragma omp parallel for schedule(static)
+  for (long c = 0; c < static_cast<long>(chunks); ++c)
+    for (size_t i = static_cast<size_t>(c) * chunk; i < std::min(count, (static_cast<size_t>(c) + 1) * chunk); ++i)
+      sorted[at[static_cast<size_t>(c) * buckets + bucket_of(keyed[i].code)]++] = keyed[i];
+#pragma omp parallel for schedule(dynamic, 256)
+  for (long b = 0; b < static_cast<long>(buckets); ++b) {
+    std::sort(sorted.get() + bucket_begin[static_cast<size_t>(b)], sorted.get() + bucket_begin[static_cast<size_t>(b) + 1]);
+    for (size_t i = bucket_begin[static_cast<size_t>(b)]; i < bucket_begin[static_cast<size_t>(b) + 1]; ++i)
+      order[i] = sorted[i].index;
+  }
   return order;
 }
 

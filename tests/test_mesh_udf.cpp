@@ -2,6 +2,9 @@
 // point-triangle distance, gradients against finite differences, the conventions on the surface, STL soups
 // against their welded OBJ, --udf-normalize, errors, and sample-seeds end to end on a mesh file.
 #include <gtest/gtest.h>
+#include <omp.h>
+
+#include <algorithm>
 
 #include <cmath>
 #include <cstring>
@@ -9,6 +12,7 @@
 
 #include "common/errors.h"
 #include "common/mesh_udf.h"
+#include "common/morton.h"
 #include "common/rng.h"
 #include "common/udf_spec.h"
 #include "formats/mesh_io.h"
@@ -182,6 +186,37 @@ TEST(MeshUdf, ResultsDoNotDependOnBatchOrderOrTheTraversalHint) {
       ASSERT_EQ(gr[pts.size() - 1 - i], g1) << i;
     }
   }
+}
+
+TEST(Morton, LargeBatchesSortAsOneSortDoesOnAnyThreads) {
+  // Clusters, exact repeats, points outside the box and non-finite ones: the order is by (code, index),
+  // the same as std::sort's on one thread, whichever path (one sort, or buckets sorted on every thread).
+  std::vector<Vec3> points;
+  Rng rng(7, 0);
+  for (int i = 0; i < 60000; ++i) {
+    const double spread = i % 3 == 0 ? 1.0 : 1e-4;
+    points.emplace_back(rng.Uniform(-spread, spread), rng.Uniform(-spread, spread), 0.3 * rng.Uniform());
+    if (i % 97 == 0) points.push_back(points[static_cast<size_t>(i) / 2]);
+  }
+  points.emplace_back(NAN, 0.0, 0.0);
+  points.emplace_back(5.0, -5.0, 5.0);
+  const Box box{Vec3(-0.5, -0.5, -0.5), Vec3(0.5, 0.5, 0.5)};
+  std::vector<std::pair<uint64_t, size_t>> keyed;
+  for (size_t i = 0; i < points.size(); ++i) keyed.emplace_back(MortonCode(points[i], box), i);
+  std::sort(keyed.begin(), keyed.end());
+  std::vector<size_t> expected;
+  for (const auto& k : keyed) expected.push_back(k.second);
+  const int threads = omp_get_max_threads();
+  for (int t : {1, 2, 3}) {
+    omp_set_num_threads(t);
+    EXPECT_EQ(MortonOrder(points, box), expected) << t << " threads";
+    const std::vector<Vec3> few(points.begin(), points.begin() + 5000);
+    std::vector<size_t> expected_few;
+    for (size_t i : expected)
+      if (i < few.size()) expected_few.push_back(i);
+    EXPECT_EQ(MortonOrder(few, box), expected_few) << t << " threads";
+  }
+  omp_set_num_threads(threads);
 }
 
 TEST(MeshUdf, ClosestPointOnTriangleHandlesEveryRegionAndDegenerateInput) {

@@ -2,6 +2,7 @@
 // gets the same points whoever else asks, a cell that moved a little keeps most of them, and the UDF is
 // asked once per point. Then the whole stage: the same seeds' quality for a fraction of the queries.
 #include <gtest/gtest.h>
+#include <omp.h>
 
 #include <algorithm>
 #include <cmath>
@@ -82,6 +83,57 @@ TEST(SamplePool, ACellGetsTheSamePointsWhoeverElseAsksAndTheUdfOnce) {
   EXPECT_EQ(alone.Evaluate(udf, SelectOne(alone, cell, 100)), 0u);
   EXPECT_EQ(usage->queries.load(), 100u);
   for (SamplePool::PointId id : a) EXPECT_NEAR(alone.Distance(id), sphere->Distance(alone.Point(id)), 1e-12);
+}
+
+// Records the points it is asked for, in order (batches are asked from one thread).
+class RecordingUdf : public Udf {
+ public:
+  explicit RecordingUdf(std::shared_ptr<Udf> inner) : inner_(std::move(inner)) {}
+  void EvaluateChunk(const Vec3* points, size_t count, double* distance, Vec3* gradient) const override {
+    inner_->EvaluateChunk(points, count, distance, gradient);
+  }
+  void Evaluate(const Vec3* points, size_t count, double* distance, Vec3* gradient) const override {
+    asked.insert(asked.end(), points, points + count);
+    inner_->Evaluate(points, count, distance, gradient);
+  }
+  Box Domain() const override { return inner_->Domain(); }
+  std::string Describe() const override { return "recording"; }
+  mutable std::vector<Vec3> asked;
+
+ private:
+  std::shared_ptr<Udf> inner_;
+};
+
+TEST(SamplePool, ABatchWithRepeatsAsksEachPointOnceInTheOrderOfFirstUseOnAnyThreads) {
+  // Overlapping cells name the same points: a batch of one cell's ids, then again backwards and interleaved
+  // with a second cell's, asks every point once, in the order of its first place in the batch, whatever
+  // the threads (the claims are made in parallel).
+  const int threads = omp_get_max_threads();
+  std::vector<std::vector<Vec3>> asked;
+  for (int t : {1, 2, 4}) {
+    omp_set_num_threads(t);
+    SamplePool pool(5, 0.03);
+    const auto a = SelectOne(pool, HalfBall(Vec3(0.5, 0.0, 0.0), 0.05), 1500);
+    const auto b = SelectOne(pool, HalfBall(Vec3(0.5, 0.02, 0.0), 0.05), 1500);
+    ASSERT_EQ(a.size(), 1500u);
+    ASSERT_EQ(b.size(), 1500u);
+    std::vector<SamplePool::PointId> ids(a.begin(), a.begin() + 500);
+    for (size_t k = 0; k < b.size(); ++k) ids.push_back(k % 2 ? b[k] : a[a.size() - 1 - k]);
+    ids.insert(ids.end(), a.rbegin(), a.rend());
+    std::vector<SamplePool::PointId> first;
+    for (SamplePool::PointId id : ids)
+      if (std::find(first.begin(), first.end(), id) == first.end()) first.push_back(id);
+    ASSERT_LT(first.size(), ids.size());
+    RecordingUdf udf(MakeShape("sphere"));
+    EXPECT_EQ(pool.Evaluate(udf, ids), first.size());
+    ASSERT_EQ(udf.asked.size(), first.size());
+    for (size_t k = 0; k < first.size(); ++k) ASSERT_EQ(udf.asked[k], pool.Point(first[k])) << "point " << k;
+    EXPECT_EQ(pool.Evaluate(udf, ids), 0u);
+    asked.push_back(udf.asked);
+  }
+  omp_set_num_threads(threads);
+  EXPECT_EQ(asked[0], asked[1]);
+  EXPECT_EQ(asked[0], asked[2]);
 }
 
 TEST(SamplePool, ACellThatMovedALittleKeepsMostOfItsSamples) {

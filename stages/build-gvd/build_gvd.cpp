@@ -496,11 +496,18 @@ std::vector<Tri> WitnessedTriples(const Graph& g, const std::vector<int>& label)
           out.push_back(t);
         }
     }
+    // Each thread's list sorted and made unique on its thread, then the lists merged: one sort of them all
+    // was a tenth of build-gvd's serial time.
+    std::sort(out.begin(), out.end());
+    out.erase(std::unique(out.begin(), out.end()), out.end());
   }
-  std::vector<Tri> faces;
-  for (auto& v : per_thread) faces.insert(faces.end(), v.begin(), v.end());
-  std::sort(faces.begin(), faces.end());
-  faces.erase(std::unique(faces.begin(), faces.end()), faces.end());
+  std::vector<Tri> faces, merged;
+  for (auto& v : per_thread) {
+    merged.clear();
+    std::merge(faces.begin(), faces.end(), v.begin(), v.end(), std::back_inserter(merged));
+    merged.erase(std::unique(merged.begin(), merged.end()), merged.end());
+    faces.swap(merged);
+  }
   return faces;
 }
 

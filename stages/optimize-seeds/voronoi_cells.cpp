@@ -175,13 +175,26 @@ void ChooseFromPool(const CellSamplingOptions& options, uint64_t round, bool inc
 // The UDF at candidates [from, to) of the cells `wanted` (from the pool's values where it has them).
 void EvaluateCandidates(const Udf& udf, const CellSamplingOptions& options, size_t from, size_t to,
                         const std::function<bool(size_t)>& wanted, CellSamples& cells, Draft& w) {
-  std::vector<size_t> at;
-  for (size_t i = 0; i < w.n; ++i)
-    if (w.redo[i] && wanted(i))
-      for (size_t k = from; k < std::min(w.accepted[i], to); ++k) at.push_back(i * w.m_max + k);
+  // Which candidates, cell by cell: counted, then listed in parallel (on one thread this was a tenth of
+  // optimize-seeds' serial time).
+  std::vector<size_t> first(w.n + 1, 0);
+#pragma omp parallel for schedule(static)
+  for (long li = 0; li < static_cast<long>(w.n); ++li) {
+    const size_t i = static_cast<size_t>(li), end = std::min(w.accepted[i], to);
+    first[i + 1] = w.redo[i] && wanted(i) && end > from ? end - from : 0;
+  }
+  for (size_t i = 0; i < w.n; ++i) first[i + 1] += first[i];
+  std::vector<size_t> at(first[w.n]);
+  std::vector<SamplePool::PointId> ids(options.pool ? at.size() : 0);
+#pragma omp parallel for schedule(static)
+  for (long li = 0; li < static_cast<long>(w.n); ++li) {
+    const size_t i = static_cast<size_t>(li);
+    for (size_t k = 0; k < first[i + 1] - first[i]; ++k) {
+      at[first[i] + k] = i * w.m_max + from + k;
+      if (options.pool) ids[first[i] + k] = w.chosen[i][from + k];
+    }
+  }
   if (options.pool) {
-    std::vector<SamplePool::PointId> ids(at.size());
-    for (size_t k = 0; k < at.size(); ++k) ids[k] = w.chosen[at[k] / w.m_max][at[k] % w.m_max];
     cells.reused += at.size() - options.pool->Evaluate(udf, ids);
 #pragma omp parallel for schedule(static)
     for (long k = 0; k < static_cast<long>(at.size()); ++k) {
