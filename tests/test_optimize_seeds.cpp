@@ -756,6 +756,55 @@ TEST(VoronoiCells, CellsFollowTheirSeedsWhenEarlierSeedsAreRemoved) {
         ASSERT_LE((after.point[m] - seeds[i]).norm(), (after.point[m] - other).norm() + 1e-12);
 }
 
+TEST(VoronoiCells, ReusedBuffersGiveTheSameCellsRoundAfterRound) {
+  // Rounds that move seeds, keep cells and drop seeds (CarryCells), once with one set of buffers that each
+  // round's result is built in (a spent result's arrays, of other sizes and stale contents) and once afresh:
+  // the same cells to the bit, with a pool and without.
+  const auto sphere = MakeShape("sphere");
+  for (const bool with_pool : {true, false}) {
+    SamplePool pool_a(3, 0.06), pool_b(3, 0.06);
+    CellSamplingOptions a, b;
+    if (with_pool) a.pool = &pool_a, b.pool = &pool_b;
+    std::vector<Vec3> seeds = Initial(*sphere, 300, 8).position, previous_seeds;
+    CellSamples cells_a, cells_b;
+    CellSamplingBuffers buffers;
+    for (uint64_t round = 0; round < 5; ++round) {
+      if (round == 3) {  // drop two seeds, as the feature steps do: the cells follow their seeds
+        std::vector<Vec3> fewer;
+        for (size_t i = 0; i < seeds.size(); ++i)
+          if (i != 7 && i != 120) fewer.push_back(seeds[i]);
+        seeds = fewer;
+        std::vector<Vec3> seeds_b = previous_seeds;
+        CarryCells(seeds, a, cells_a, previous_seeds, &buffers.spare);
+        CarryCells(seeds, b, cells_b, seeds_b);
+      } else if (round > 0) {  // move a tenth of the seeds along the sphere
+        for (size_t i = round; i < seeds.size(); i += 10) seeds[i] = (seeds[i] + Vec3(0.0, 0.004, 0.002)).normalized() * 0.5;
+      }
+      const SeedIndex index(seeds);
+      CellSamples next_a = SampleVoronoiCells(*sphere, seeds, index, a, 1, round, round ? &cells_a : nullptr,
+                                              round ? &previous_seeds : nullptr, &buffers);
+      const CellSamples next_b = SampleVoronoiCells(*sphere, seeds, index, b, 1, round, round ? &cells_b : nullptr,
+                                                    round ? &previous_seeds : nullptr);
+      buffers.spare = std::move(cells_a);
+      cells_a = std::move(next_a);
+      cells_b = next_b;
+      previous_seeds = seeds;
+      ASSERT_EQ(cells_a.sample_offset, cells_b.sample_offset) << "round " << round;
+      EXPECT_EQ(cells_a.point, cells_b.point) << "round " << round;
+      EXPECT_EQ(cells_a.distance, cells_b.distance) << "round " << round;
+      EXPECT_EQ(cells_a.gradient, cells_b.gradient) << "round " << round;
+      EXPECT_EQ(cells_a.neighbour_offset, cells_b.neighbour_offset) << "round " << round;
+      EXPECT_EQ(cells_a.neighbour, cells_b.neighbour) << "round " << round;
+      EXPECT_EQ(cells_a.radius, cells_b.radius) << "round " << round;
+      EXPECT_EQ(cells_a.redrawn, cells_b.redrawn) << "round " << round;
+      EXPECT_EQ(cells_a.reused, cells_b.reused) << "round " << round;
+      if (round > 0 && round != 3) {
+        EXPECT_LT(cells_a.redrawn, seeds.size()) << "round " << round;
+      }
+    }
+  }
+}
+
 // Early samples: a cell that clearly sees one plane keeps the first samples of the very draw it would
 // have made whole; a cell on a cube edge or corner (two or three planes) gets all M.
 TEST(VoronoiCells, EarlySamplesArePrefixesAndFeatureCellsStayWhole) {

@@ -118,9 +118,12 @@ const CellSamples& Optimizer::Analyze(SeedState& s, bool early) {
   }
   // Seeds dropped since the last call shift the later ones' indices: the cache follows them by position.
   if (!cached_positions_.empty() && cached_positions_.size() != s.position.size())
-    CarryCells(s.position, cell_options, cached_cells_, cached_positions_);
-  cached_cells_ = SampleVoronoiCells(udf_, s.position, index, cell_options, options_.seed, round_++,
-                                     cached_positions_.empty() ? nullptr : &cached_cells_, &cached_positions_);
+    CarryCells(s.position, cell_options, cached_cells_, cached_positions_, &cell_buffers_.spare);
+  CellSamples next = SampleVoronoiCells(udf_, s.position, index, cell_options, options_.seed, round_++,
+                                        cached_positions_.empty() ? nullptr : &cached_cells_, &cached_positions_,
+                                        &cell_buffers_);
+  cell_buffers_.spare = std::move(cached_cells_);
+  cached_cells_ = std::move(next);
   cached_positions_ = s.position;
   // The cache keeps the field's own values and gradients (a kept cell is fitted afresh): sample planes are
   // changed on a copy. Without them the cache is the result, and megabytes are not copied on one thread.

@@ -145,6 +145,7 @@ class Optimizer {
   uint64_t round_ = 0;  // sampling rounds so far: the random stream of every round differs
   CellSamples cached_cells_;             // the last round's cells, reused where nothing nearby moved
   CellSamples planed_cells_;             // the same with fitted or centred sample planes (noisy fields only)
+  CellSamplingBuffers cell_buffers_;     // the cells' working memory, kept from round to round
   std::vector<Vec3> cached_positions_;
   size_t last_short_cells_ = 0;
   double last_acceptance_ = 0.0;

@@ -29,6 +29,21 @@ void SizeToOffsets(CellSamples& cells) {
   cells.gradient.resize(cells.sample_offset.back());
 }
 
+// A spent result's arrays for a new one (its memory is reused): the sample and neighbour arrays keep their
+// size, since their fillers write every slot; the per-cell arrays and the counts start afresh.
+CellSamples Recycled(CellSamples& spare) {
+  CellSamples cells = std::move(spare);
+  spare = CellSamples{};
+  cells.draws = cells.drawn_samples = 0;
+  cells.short_cells = cells.redrawn = cells.early_cells = cells.reused = 0;
+  cells.radius.clear();
+  cells.neighbour_offset.clear();
+  cells.sample_offset.clear();
+  cells.pool_mark.clear();
+  cells.early_kept.clear();
+  return cells;
+}
+
 // Cell i's samples of `from` into `to` from sample `at` on (to's arrays already sized).
 void CopyCellSamples(const CellSamples& from, size_t i, CellSamples& to, size_t at) {
   const long begin = static_cast<long>(from.sample_offset[i]);
@@ -39,22 +54,22 @@ void CopyCellSamples(const CellSamples& from, size_t i, CellSamples& to, size_t 
   std::copy_n(from.gradient.begin() + begin, count, to.gradient.begin() + to_begin);
 }
 
-// A call's working state: per cell, its neighbours and its candidates (M slots each, `accepted` used) with
-// their UDF values; the pool's choice when there is one.
+// A call's working state: per cell, its neighbours and its samples: the pool's choice when there is one,
+// else candidates drawn afresh (M slots each, `accepted` used) with their UDF values.
 struct Draft {
   size_t n = 0, m_max = 0;
   std::vector<char> redo;  // the cell is sampled in this call (else kept from the previous one)
   std::vector<std::vector<int>> neighbours;
-  std::vector<Vec3> candidates;
   std::vector<size_t> accepted;
   std::vector<uint64_t> draws;
   std::vector<char> short_draw;  // the rejection budget ran out before M samples
   std::vector<SamplePool::Cell> shapes;  // with a pool: the cells' shapes, their samples chosen afterwards
   std::vector<std::vector<SamplePool::PointId>> chosen;
-  // Uninitialised: only the accepted slots are written (in parallel) and read; zeroing them all first cost a
-  // serial pass over fresh pages at every call.
-  std::unique_ptr<double[]> cand_d;
-  std::unique_ptr<Vec3[]> cand_g;
+  // Without a pool, M slots per cell (the caller's buffers, kept from call to call): only the accepted slots
+  // are written (in parallel) and read.
+  Vec3* candidates = nullptr;
+  double* cand_d = nullptr;
+  Vec3* cand_g = nullptr;
 };
 
 // Which cells must be redrawn: all, or (given the previous round) those with a moved seed within their
@@ -168,7 +183,6 @@ void ChooseFromPool(const CellSamplingOptions& options, uint64_t round, bool inc
     w.accepted[i] = w.chosen[i].size();
     w.draws[i] = std::max<uint64_t>(examined[i], w.accepted[i]);
     w.short_draw[i] = w.accepted[i] < w.m_max;
-    for (size_t k = 0; k < w.accepted[i]; ++k) w.candidates[i * w.m_max + k] = options.pool->Point(w.chosen[i][k]);
   }
 }
 
@@ -184,23 +198,21 @@ void EvaluateCandidates(const Udf& udf, const CellSamplingOptions& options, size
     first[i + 1] = w.redo[i] && wanted(i) && end > from ? end - from : 0;
   }
   for (size_t i = 0; i < w.n; ++i) first[i + 1] += first[i];
-  std::vector<size_t> at(first[w.n]);
-  std::vector<SamplePool::PointId> ids(options.pool ? at.size() : 0);
+  // With a pool the values stay in the pool, where Assemble reads them.
+  std::vector<size_t> at(options.pool ? 0 : first[w.n]);
+  std::vector<SamplePool::PointId> ids(options.pool ? first[w.n] : 0);
 #pragma omp parallel for schedule(static)
   for (long li = 0; li < static_cast<long>(w.n); ++li) {
     const size_t i = static_cast<size_t>(li);
     for (size_t k = 0; k < first[i + 1] - first[i]; ++k) {
-      at[first[i] + k] = i * w.m_max + from + k;
-      if (options.pool) ids[first[i] + k] = w.chosen[i][from + k];
+      if (options.pool)
+        ids[first[i] + k] = w.chosen[i][from + k];
+      else
+        at[first[i] + k] = i * w.m_max + from + k;
     }
   }
   if (options.pool) {
-    cells.reused += at.size() - options.pool->Evaluate(udf, ids);
-#pragma omp parallel for schedule(static)
-    for (long k = 0; k < static_cast<long>(at.size()); ++k) {
-      w.cand_d[at[static_cast<size_t>(k)]] = options.pool->Distance(ids[static_cast<size_t>(k)]);
-      w.cand_g[at[static_cast<size_t>(k)]] = options.pool->Gradient(ids[static_cast<size_t>(k)]);
-    }
+    cells.reused += ids.size() - options.pool->Evaluate(udf, ids);
     return;
   }
   std::vector<Vec3> points(at.size());
@@ -223,8 +235,6 @@ void EvaluateCells(const Udf& udf, const CellSamplingOptions& options, const Cel
   cells.early_kept.assign(n, 0);
   for (size_t i = 0; i < n; ++i)
     if (!w.redo[i] && !previous->early_kept.empty()) cells.early_kept[i] = previous->early_kept[i];
-  w.cand_d.reset(new double[n * m_max]);
-  w.cand_g.reset(new Vec3[n * m_max]);
   const size_t early = options.early_samples > 0 ? std::min(m_max, static_cast<size_t>(options.early_samples)) : m_max;
   EvaluateCandidates(udf, options, 0, early, [](size_t) { return true; }, cells, w);
   if (early == m_max) return;
@@ -235,7 +245,11 @@ void EvaluateCells(const Udf& udf, const CellSamplingOptions& options, const Cel
       more[i] = 1;
       continue;
     }
-    const TangentRank r = ComputeTangentRank(w.cand_g.get() + i * m_max, early, options.early_rank_threshold);
+    std::vector<Vec3> from_pool;
+    if (options.pool)
+      for (size_t k = 0; k < early; ++k) from_pool.push_back(options.pool->Gradient(w.chosen[i][k]));
+    const TangentRank r = ComputeTangentRank(options.pool ? from_pool.data() : w.cand_g + i * m_max, early,
+                                             options.early_rank_threshold);
     if (r.rank == 1) {
       w.accepted[i] = early;
       cells.early_kept[i] = 1;
@@ -248,7 +262,7 @@ void EvaluateCells(const Udf& udf, const CellSamplingOptions& options, const Cel
 }
 
 // The result in CSR form: the redrawn cells' samples, the kept cells' previous ones.
-void Assemble(const CellSamples* previous, const Draft& w, CellSamples& cells) {
+void Assemble(const CellSamples* previous, const Draft& w, const SamplePool* pool, CellSamples& cells) {
   const size_t n = w.n, m_max = w.m_max;
   cells.neighbour_offset.assign(n + 1, 0);
   cells.sample_offset.assign(n + 1, 0);
@@ -270,11 +284,18 @@ void Assemble(const CellSamples* previous, const Draft& w, CellSamples& cells) {
     const size_t i = static_cast<size_t>(li);
     std::copy(w.neighbours[i].begin(), w.neighbours[i].end(), cells.neighbour.begin() + static_cast<long>(cells.neighbour_offset[i]));
     const long to = static_cast<long>(cells.sample_offset[i]);
-    if (w.redo[i]) {
+    if (w.redo[i] && pool) {
+      for (size_t k = 0; k < w.accepted[i]; ++k) {
+        const SamplePool::PointId id = w.chosen[i][k];
+        cells.point[static_cast<size_t>(to) + k] = pool->Point(id);
+        cells.distance[static_cast<size_t>(to) + k] = pool->Distance(id);
+        cells.gradient[static_cast<size_t>(to) + k] = pool->Gradient(id);
+      }
+    } else if (w.redo[i]) {
       const long from = static_cast<long>(i * m_max), count = static_cast<long>(w.accepted[i]);
-      std::copy_n(w.candidates.begin() + from, count, cells.point.begin() + to);
-      std::copy_n(w.cand_d.get() + from, count, cells.distance.begin() + to);
-      std::copy_n(w.cand_g.get() + from, count, cells.gradient.begin() + to);
+      std::copy_n(w.candidates + from, count, cells.point.begin() + to);
+      std::copy_n(w.cand_d + from, count, cells.distance.begin() + to);
+      std::copy_n(w.cand_g + from, count, cells.gradient.begin() + to);
     } else {
       CopyCellSamples(*previous, i, cells, cells.sample_offset[i]);
     }
@@ -285,29 +306,40 @@ void Assemble(const CellSamples* previous, const Draft& w, CellSamples& cells) {
 
 CellSamples SampleVoronoiCells(const Udf& udf, const std::vector<Vec3>& seeds, const SeedIndex& index,
                                const CellSamplingOptions& options, uint64_t rng_seed, uint64_t round,
-                               const CellSamples* previous, const std::vector<Vec3>* previous_seeds) {
+                               const CellSamples* previous, const std::vector<Vec3>* previous_seeds,
+                               CellSamplingBuffers* buffers) {
+  CellSamplingBuffers local;
+  CellSamplingBuffers& buf = buffers ? *buffers : local;
   Draft w;
   w.n = seeds.size();
   w.m_max = static_cast<size_t>(options.samples_per_cell);
   const bool incremental = previous && previous_seeds && previous->radius.size() == previous_seeds->size();
   w.redo = CellsToRedraw(seeds, index, options, incremental ? previous : nullptr, previous_seeds);
   w.neighbours.resize(w.n);
-  w.candidates.resize(w.n * w.m_max);
+  // Without a pool, M slots per cell; resized, not cleared: a buffer of last call's size is not written over
+  // twice (every slot that is read is written in this call). A pool's points and values are read from it.
+  const size_t slots = options.pool ? 0 : w.n * w.m_max;
+  buf.candidate.resize(slots);
+  buf.candidate_distance.resize(slots);
+  buf.candidate_gradient.resize(slots);
+  w.candidates = buf.candidate.data();
+  w.cand_d = buf.candidate_distance.data();
+  w.cand_g = buf.candidate_gradient.data();
   w.accepted.assign(w.n, 0);
   w.draws.assign(w.n, 0);
   w.short_draw.assign(w.n, 0);
   w.shapes.resize(options.pool ? w.n : 0);
-  CellSamples cells;
+  CellSamples cells = Recycled(buf.spare);
   cells.radius.assign(w.n, 0.0);
   DrawCells(seeds, index, options, rng_seed, round, previous, cells, w);
   if (options.pool) ChooseFromPool(options, round, incremental, previous, cells, w);
   EvaluateCells(udf, options, previous, cells, w);
-  Assemble(previous, w, cells);
+  Assemble(previous, w, options.pool, cells);
   return cells;
 }
 
 void CarryCells(const std::vector<Vec3>& seeds, const CellSamplingOptions& options, CellSamples& previous,
-                std::vector<Vec3>& previous_seeds) {
+                std::vector<Vec3>& previous_seeds, CellSamples* spare) {
   const size_t n = seeds.size(), before = previous_seeds.size();
   // Previous seeds by exact position (ties by index), to find each seed's earlier self.
   std::vector<size_t> order(before);
@@ -330,7 +362,8 @@ void CarryCells(const std::vector<Vec3>& seeds, const CellSamplingOptions& optio
     if (new_of[k] < 0) gone.push_back(previous_seeds[k]);
   const std::unique_ptr<SeedIndex> gone_index = gone.empty() ? nullptr : std::make_unique<SeedIndex>(gone);
   const bool marks = previous.pool_mark.size() == before, early = previous.early_kept.size() == before;
-  CellSamples carried;
+  CellSamples unused;
+  CellSamples carried = Recycled(spare ? *spare : unused);
   carried.radius.assign(n, 0.0);
   carried.neighbour_offset.assign(n + 1, 0);
   carried.sample_offset.assign(n + 1, 0);
@@ -380,6 +413,7 @@ void CarryCells(const std::vector<Vec3>& seeds, const CellSamplingOptions& optio
       carried.neighbour[to++] = static_cast<int>(new_of[static_cast<size_t>(previous.neighbour[m])]);
     CopyCellSamples(previous, ku, carried, carried.sample_offset[i]);
   }
+  if (spare) *spare = std::move(previous);
   previous = std::move(carried);
   previous_seeds = std::move(carried_seeds);
 }

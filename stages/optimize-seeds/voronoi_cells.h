@@ -50,6 +50,15 @@ struct CellSamples {
   std::vector<char> early_kept;          ///< per cell: 1 if it has its early samples only
 };
 
+/// Memory SampleVoronoiCells keeps from call to call: the candidates' arrays and a spent result whose
+/// arrays are filled again. At 50k seeds a call's samples take half a gigabyte; allocated afresh at every
+/// call, each of their pages was first cleared by the kernel (a fifth of optimize-seeds' time at 50k seeds).
+struct CellSamplingBuffers {
+  std::vector<Vec3> candidate, candidate_gradient;  ///< M slots per cell
+  std::vector<double> candidate_distance;
+  CellSamples spare;  ///< a result no longer needed (its contents are not read)
+};
+
 /// Draws up to M points uniformly in Ω_i ∩ B(x_i, R_i) for every seed by rejection from the ball's bounding cube (exact
 /// nearest-seed test against the seeds within 2 R_i, found with PCL's kd-tree), then evaluates the UDF at
 /// all of them in one batch. Seed i draws from the counter-based stream (rng_seed, round · N + i), so the
@@ -63,10 +72,11 @@ struct CellSamples {
 /// set, so redrawing it would only change the random draw. Early on, when σ is small and few seeds
 /// move, this saves most of the UDF evaluations. Seeds appended at the end, or removed from it, since the
 /// previous call count as moved (removals elsewhere: CarryCells first). A cell that kept only its early samples is redrawn when this call wants
-/// every cell whole (early_samples = 0).
+/// every cell whole (early_samples = 0). `buffers` (optional) only saves allocations: the result is the same.
 CellSamples SampleVoronoiCells(const Udf& udf, const std::vector<Vec3>& seeds, const SeedIndex& index,
                                const CellSamplingOptions& options, uint64_t rng_seed, uint64_t round,
-                               const CellSamples* previous = nullptr, const std::vector<Vec3>* previous_seeds = nullptr);
+                               const CellSamples* previous = nullptr, const std::vector<Vec3>* previous_seeds = nullptr,
+                               CellSamplingBuffers* buffers = nullptr);
 
 /// For SampleVoronoiCells' incremental use after seeds were removed from anywhere in the list (which shifts
 /// the indices of all later ones): re-indexes `previous` and `previous_seeds` to `seeds`. Seed i takes the
@@ -74,8 +84,9 @@ CellSamples SampleVoronoiCells(const Udf& udf, const std::vector<Vec3>& seeds, c
 /// neighbours are still there and no previous seed within its influence radius has gone or moved. Any other
 /// seed gets no cell (radius 0), so its cell is redrawn; a seed with no previous seed at its position also
 /// gets a NaN previous position, so it counts as moved (the cells it cuts are redrawn too). Invariant: a
-/// carried cell is exactly the set it was. \pre previous's cells belong to previous_seeds.
+/// carried cell is exactly the set it was. \pre previous's cells belong to previous_seeds. `spare`
+/// (optional): a spent result whose memory the carried cells take; it gets the previous cells' memory.
 void CarryCells(const std::vector<Vec3>& seeds, const CellSamplingOptions& options, CellSamples& previous,
-                std::vector<Vec3>& previous_seeds);
+                std::vector<Vec3>& previous_seeds, CellSamples* spare = nullptr);
 
 }  // namespace voroudf
