@@ -21,12 +21,24 @@ double InfluenceRadius(double r, const CellSamplingOptions& options) {
   return std::max(2.0, 1.0 / options.radius_factor) * r * (1.0 + 1e-5) + 1e-12;
 }
 
+// `v` resized for arrays whose every slot is about to be written. Growing past its capacity, it is released
+// first (its contents would only be copied to be overwritten) and reserved with room for the next calls'
+// slightly larger sizes (the feature steps alternate between the seeds and the seeds with trials).
+template <typename T>
+void ResizeForOverwrite(std::vector<T>& v, size_t size) {
+  if (size > v.capacity()) {
+    std::vector<T>().swap(v);
+    v.reserve(size + size / 8);
+  }
+  v.resize(size);
+}
+
 // The neighbour and sample arrays sized by the offsets already set.
 void SizeToOffsets(CellSamples& cells) {
-  cells.neighbour.resize(cells.neighbour_offset.back());
-  cells.point.resize(cells.sample_offset.back());
-  cells.distance.resize(cells.sample_offset.back());
-  cells.gradient.resize(cells.sample_offset.back());
+  ResizeForOverwrite(cells.neighbour, cells.neighbour_offset.back());
+  ResizeForOverwrite(cells.point, cells.sample_offset.back());
+  ResizeForOverwrite(cells.distance, cells.sample_offset.back());
+  ResizeForOverwrite(cells.gradient, cells.sample_offset.back());
 }
 
 // A spent result's arrays for a new one (its memory is reused): the sample and neighbour arrays keep their
@@ -319,9 +331,9 @@ CellSamples SampleVoronoiCells(const Udf& udf, const std::vector<Vec3>& seeds, c
   // Without a pool, M slots per cell; resized, not cleared: a buffer of last call's size is not written over
   // twice (every slot that is read is written in this call). A pool's points and values are read from it.
   const size_t slots = options.pool ? 0 : w.n * w.m_max;
-  buf.candidate.resize(slots);
-  buf.candidate_distance.resize(slots);
-  buf.candidate_gradient.resize(slots);
+  ResizeForOverwrite(buf.candidate, slots);
+  ResizeForOverwrite(buf.candidate_distance, slots);
+  ResizeForOverwrite(buf.candidate_gradient, slots);
   w.candidates = buf.candidate.data();
   w.cand_d = buf.candidate_distance.data();
   w.cand_g = buf.candidate_gradient.data();
