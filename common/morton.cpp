@@ -70,11 +70,13 @@ std::vector<size_t> MortonOrder(const Vec3* points, size_t count, const Box& box
   const size_t buckets = static_cast<size_t>((hi - lo) >> shift) + 1;
   const auto bucket_of = [&](uint64_t code) { return static_cast<size_t>((code - lo) >> shift); };
   const size_t chunks = std::min<size_t>(16, (count + 4095) / 4096), chunk = (count + chunks - 1) / chunks;
-  std::vector<size_t> at(chunks * buckets, 0);  // per chunk and bucket: its count, then where it writes
+  // Per chunk and bucket: its count, then where the chunk's next key of that bucket goes.
+  std::vector<size_t> at(chunks * buckets, 0);
+  const auto slot = [&](size_t c, size_t i) -> size_t& { return at[c * buckets + bucket_of(keyed[i].code)]; };
+  const auto chunk_end = [&](size_t c) { return std::min(count, (c + 1) * chunk); };
 #pragma omp parallel for schedule(static)
-  for (long c = 0; c < static_cast<long>(chunks); ++c)
-    for (size_t i = static_cast<size_t>(c) * chunk; i < std::min(count, (static_cast<size_t>(c) + 1) * chunk); ++i)
-      ++at[static_cast<size_t>(c) * buckets + bucket_of(keyed[i].code)];
+  for (long lc = 0; lc < static_cast<long>(chunks); ++lc)
+    for (size_t c = static_cast<size_t>(lc), i = c * chunk; i < chunk_end(c); ++i) ++slot(c, i);
   std::vector<size_t> bucket_begin(buckets + 1, 0);
   for (size_t b = 0, total = 0; b < buckets; ++b) {
     bucket_begin[b] = total;
@@ -87,9 +89,8 @@ std::vector<size_t> MortonOrder(const Vec3* points, size_t count, const Box& box
   bucket_begin[buckets] = count;
   const std::unique_ptr<Keyed[]> sorted(new Keyed[count]);
 #pragma omp parallel for schedule(static)
-  for (long c = 0; c < static_cast<long>(chunks); ++c)
-    for (size_t i = static_cast<size_t>(c) * chunk; i < std::min(count, (static_cast<size_t>(c) + 1) * chunk); ++i)
-      sorted[at[static_cast<size_t>(c) * buckets + bucket_of(keyed[i].code)]++] = keyed[i];
+  for (long lc = 0; lc < static_cast<long>(chunks); ++lc)
+    for (size_t c = static_cast<size_t>(lc), i = c * chunk; i < chunk_end(c); ++i) sorted[slot(c, i)++] = keyed[i];
 #pragma omp parallel for schedule(dynamic, 256)
   for (long b = 0; b < static_cast<long>(buckets); ++b) {
     std::sort(sorted.get() + bucket_begin[static_cast<size_t>(b)], sorted.get() + bucket_begin[static_cast<size_t>(b) + 1]);

@@ -56,13 +56,18 @@ class SamplePool {
   /// Returns how many were asked.
   size_t Evaluate(const Udf& udf, const std::vector<PointId>& ids);
 
-  Vec3 Point(PointId id) const {
-    const Entry_& e = Entry(id);
-    return buckets_[id >> kBucketShift].origin + Vec3(e.offset[0], e.offset[1], e.offset[2]);
-  }
+  Vec3 Point(PointId id) const { return PointOf(id, Entry(id)); }
   /// \pre Evaluate has seen `id`
   double Distance(PointId id) const { return ValueOf(Entry(id).value).distance; }
   const Vec3& Gradient(PointId id) const { return ValueOf(Entry(id).value).gradient; }
+  /// Point, Distance and Gradient at once, from one look-up of the point's entry. \pre Evaluate has seen `id`
+  void Sample(PointId id, Vec3* point, double* distance, Vec3* gradient) const {
+    const Entry_& e = Entry(id);
+    *point = PointOf(id, e);
+    const Value& v = ValueOf(e.value);
+    *distance = v.distance;
+    *gradient = v.gradient;
+  }
 
   int layers() const { return layers_; }
   size_t points() const;                              ///< generated so far
@@ -104,6 +109,9 @@ class SamplePool {
   const Entry_& Entry(PointId id) const {
     const Bucket& b = buckets_[id >> kBucketShift];
     return b.entries[b.begin[(id >> kIndexBits) & kPartMask] + (id & kIndexMask)];
+  }
+  Vec3 PointOf(PointId id, const Entry_& e) const {
+    return buckets_[id >> kBucketShift].origin + Vec3(e.offset[0], e.offset[1], e.offset[2]);
   }
   Entry_& Entry(PointId id) {
     Bucket& b = buckets_[id >> kBucketShift];

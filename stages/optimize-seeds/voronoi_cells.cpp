@@ -298,10 +298,8 @@ void Assemble(const CellSamples* previous, const Draft& w, const SamplePool* poo
     const long to = static_cast<long>(cells.sample_offset[i]);
     if (w.redo[i] && pool) {
       for (size_t k = 0; k < w.accepted[i]; ++k) {
-        const SamplePool::PointId id = w.chosen[i][k];
-        cells.point[static_cast<size_t>(to) + k] = pool->Point(id);
-        cells.distance[static_cast<size_t>(to) + k] = pool->Distance(id);
-        cells.gradient[static_cast<size_t>(to) + k] = pool->Gradient(id);
+        const size_t at = static_cast<size_t>(to) + k;
+        pool->Sample(w.chosen[i][k], &cells.point[at], &cells.distance[at], &cells.gradient[at]);
       }
     } else if (w.redo[i]) {
       const long from = static_cast<long>(i * m_max), count = static_cast<long>(w.accepted[i]);
