@@ -66,22 +66,35 @@ void FitCell(const CellSamples& cells, size_t begin, size_t end, const SamplePla
       }
     }
     if (count < static_cast<size_t>(fit.min_neighbours)) continue;
-    Vec3 c = Vec3::Zero();
-    for (size_t q = 0; q < count; ++q) c += foot[best_i[q]];
-    c /= static_cast<double>(count);
-    Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
-    for (size_t q = 0; q < count; ++q) {
-      const Vec3 v = foot[best_i[q]] - c;
-      cov += v * v.transpose();
+    // The plane of the foot points, then of the points p − d n̂ along that plane's normal: a foot point
+    // along a gradient turned by θ lies d (1 − cos θ) off the surface on its sample's side, which offsets the
+    // first plane by the mean of that (half the cell's error at 15°); the second puts each point on the
+    // surface wherever n̂ is the surface's normal, whatever the gradient.
+    Vec3 c, n, lambda;
+    bool plane = true;
+    for (int pass = 0; pass < 2 && plane; ++pass) {
+      auto point = [&](size_t q) -> Vec3 {
+        const size_t b = best_i[q];
+        return pass == 0 ? foot[b] : Vec3(cells.point[begin + b] - cells.distance[begin + b] * n);
+      };
+      c = Vec3::Zero();
+      for (size_t q = 0; q < count; ++q) c += point(q);
+      c /= static_cast<double>(count);
+      Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+      for (size_t q = 0; q < count; ++q) {
+        const Vec3 v = point(q) - c;
+        cov += v * v.transpose();
+      }
+      Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig;
+      eig.computeDirect(cov);  // closed form for 3 x 3; eigenvalues ascending
+      // Points that do not lie on one plane (two sheets closer than the neighbourhood, a corner) give no
+      // plane: the samples near them keep their gradients'.
+      lambda = eig.eigenvalues().cwiseMax(0.0);
+      plane = lambda[0] <= fit.max_thickness * fit.max_thickness * lambda[1];
+      n = eig.eigenvectors().col(0);
+      if (n.dot(unit[a]) < 0.0) n = -n;
     }
-    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig;
-    eig.computeDirect(cov);  // closed form for 3 x 3; eigenvalues ascending
-    // Foot points that do not lie on one plane (two sheets closer than the neighbourhood, a corner) give no
-    // plane: the samples near them keep their gradients'.
-    const Vec3 lambda = eig.eigenvalues().cwiseMax(0.0);
-    if (lambda[0] > fit.max_thickness * fit.max_thickness * lambda[1]) continue;
-    Vec3 n = eig.eigenvectors().col(0);
-    if (n.dot(unit[a]) < 0.0) n = -n;
+    if (!plane) continue;
     anchor.push_back(a);
     anchor_normal.push_back(n);
     anchor_spread.push_back(std::sqrt(lambda[1] / static_cast<double>(count)));
@@ -137,13 +150,12 @@ SamplePlanes FitSamplePlanes(const CellSamples& cells, const SamplePlaneFit& fit
   return planes;
 }
 
-void CenterTwinPlanes(CellSamples& cells, double within, double tolerance, const std::vector<char>* fitted) {
+void CenterTwinPlanes(CellSamples& cells, double within, double tolerance, bool mid_planes) {
   const long n = static_cast<long>(cells.sample_offset.size()) - 1;
   const double other_side = -std::cos(50.0 * M_PI / 180.0);
   std::vector<double> centred = cells.distance;
-  // Only kept samples among fitted ones change their normals.
   std::vector<Vec3> centred_normal;
-  if (fitted != nullptr) centred_normal = cells.gradient;
+  if (mid_planes) centred_normal = cells.gradient;
 #pragma omp parallel for schedule(dynamic, 16)
   for (long i = 0; i < n; ++i) {
     const size_t begin = cells.sample_offset[static_cast<size_t>(i)], end = cells.sample_offset[static_cast<size_t>(i) + 1];
@@ -169,12 +181,12 @@ void CenterTwinPlanes(CellSamples& cells, double within, double tolerance, const
       if (best == SIZE_MAX) continue;
       const double gap = unit[a].dot(foot[a] - foot[best]);
       if (std::abs(gap) >= within) continue;
-      if (fitted == nullptr || (*fitted)[begin + a]) {
+      if (!mid_planes) {
         centred[begin + a] += 0.5 * gap;
         continue;
       }
-      // A sample that kept its gradient's plane among fitted ones takes the mid-plane of the two: the mean
-      // of their signed distances (with opposite normals exactly value += gap / 2).
+      // The mid-plane of the two: the mean of their signed distances (with opposite normals exactly
+      // value += gap / 2).
       const Vec3 mid = 0.5 * (unit[a] - unit[best]);
       const Vec3& p = cells.point[begin + a];
       const double height = 0.5 * (unit[a].dot(p - foot[a]) - unit[best].dot(p - foot[best]));
@@ -184,7 +196,7 @@ void CenterTwinPlanes(CellSamples& cells, double within, double tolerance, const
     }
   }
   cells.distance.swap(centred);
-  if (fitted != nullptr) cells.gradient.swap(centred_normal);
+  if (mid_planes) cells.gradient.swap(centred_normal);
 }
 
 void UseSamplePlanes(CellSamples& cells, SamplePlanes& planes) {

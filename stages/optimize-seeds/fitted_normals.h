@@ -33,9 +33,12 @@ struct SamplePlanes {
 /// θ tilts that plane by θ, but moves the foot point off the surface by only d_m (1 − cos θ) (3.4 % of d_m at
 /// 15°): the foot points keep the surface where the gradients lose it. So each sample's plane becomes the
 /// total-least-squares plane of the foot points of its own cell nearest its own (PCA; Hoppe et al. 1992),
-/// among the samples whose gradients agree with its own within `agree_deg` (the same face of a crease):
-/// gradient ← that plane's unit normal n̂ (turned towards g_m), distance ← n̂ᵀ(p_m − c̄), c̄ the neighbours'
-/// centroid. On a plane with exact gradients this is the same plane.
+/// among the samples whose gradients agree with its own within `agree_deg` (the same face of a crease),
+/// fitted a second time to those samples' points p − d n̂ along the first plane's normal n̂ (the foot points
+/// sit on their samples' side, which offsets the first plane; along the surface's normal the values put each
+/// point on the surface): gradient ← the second plane's unit normal n̂ (turned towards g_m), distance ←
+/// n̂ᵀ(p_m − c̄), c̄ the centroid of those points. On a plane with exact values this is the plane whatever the
+/// gradients.
 /// A fit whose foot points are no plane (√(λ₀/λ₁) > max_thickness: sheets closer than the neighbourhood, a
 /// corner) is dropped; a sample takes the plane of the nearest fitted anchor that agrees with it and whose plane
 /// its own foot point lies on (within max_thickness × the fit's spread), else keeps its gradient's plane.
@@ -57,14 +60,13 @@ void UseSamplePlanes(CellSamples& cells, SamplePlanes& planes);
 /// whose samples all face one way keep their planes. Only for fields whose projection merges twins (the
 /// caller's test): an exact field's two sides give the same planes, and where a field's floors come without
 /// twins (a grid's rounded valleys) the foot points are off near the surface only, not by -e for every sample.
-/// With `fitted` (the planes came from FitSamplePlanes, SamplePlanes::fitted), a sample that kept its
-/// gradient's plane (no fit: foot points on an edge line, a corner) takes the mid-plane of its own and its
-/// partner's, normal ∝ n̂_m − n̂_other, value the mean of the two planes' signed distances at p_m: its
-/// gradient's error is then averaged with the partner's, and a tilt the error gives both sides alike (the value
-/// error's slope) cancels. A fitted sample's normal is already the surface's and only its value moves.
-/// \pre within > 0; fitted, if given, has one entry per sample
-void CenterTwinPlanes(CellSamples& cells, double within, double tolerance,
-                      const std::vector<char>* fitted = nullptr);
+/// With `mid_planes` (the planes came from FitSamplePlanes) each sample instead takes the mid-plane of its own
+/// and its partner's, normal ∝ n̂_m − n̂_other, value the mean of the two planes' signed distances at p_m: a
+/// fitted plane is the field's zero sheet on its own side, which the value error's slope tilts one way on one
+/// side and the mirror way on the other, and a kept gradient's error is averaged with the partner's. With exact
+/// gradients (no fit) the normals are the surface's and only the values move.
+/// \pre within > 0
+void CenterTwinPlanes(CellSamples& cells, double within, double tolerance, bool mid_planes = false);
 
 /// How far a field's value errors tilt its zero set (radians), from the values `floor` at `points` where a
 /// projection stopped at a floor or ridge (|d + e| = |e| there, common/projection.h): atan(s / cos 45°), s

@@ -130,7 +130,7 @@ const CellSamples& Optimizer::Analyze(SeedState& s, bool early) {
   const bool planes_change = fit_planes_ != 0 || centre_twin_planes_;
   if (planes_change) planed_cells_ = cached_cells_;
   CellSamples& cells = planes_change ? planed_cells_ : cached_cells_;
-  std::vector<char> fitted;
+  bool fitted = false;
   if (fit_planes_ != 0) {
     SamplePlanes planes = FitSamplePlanes(cells, SamplePlaneFit{});
     gradient_error_ = planes.median_angle;
@@ -142,12 +142,12 @@ const CellSamples& Optimizer::Analyze(SeedState& s, bool early) {
     }
     if (fit_planes_ > 0) {
       UseSamplePlanes(cells, planes);
-      fitted.swap(planes.fitted);
+      fitted = true;
     }
     monitor_.Debug(Format("sample planes: gradients %.2f deg off (median)", gradient_error_ * 180.0 / M_PI));
   }
   if (centre_twin_planes_)
-    CenterTwinPlanes(cells, projection_.twin_within, projection_.tolerance, fitted.empty() ? nullptr : &fitted);
+    CenterTwinPlanes(cells, projection_.twin_within, projection_.tolerance, fitted);
   const long n = static_cast<long>(s.position.size());
   std::vector<TangentRank> ranks(static_cast<size_t>(n));
 #pragma omp parallel for schedule(static)
