@@ -194,8 +194,9 @@ TEST(FittedSamplePlanes, TurnedGradientsDoNotOffsetTheFittedPlane) {
   for (size_t k = 0; k < fitted.point.size(); ++k) {
     if (!which[k]) continue;  // kept its gradient's plane
     ++on;
-    worst = std::max(worst, std::abs(OffThePlane(fitted, k)));
-    sum += std::abs(OffThePlane(fitted, k));
+    const double off = std::abs(OffThePlane(fitted, k));
+    worst = std::max(worst, off);
+    sum += off;
   }
   EXPECT_GT(on, 80u);
   EXPECT_LT(sum / static_cast<double>(on), 1e-4);

@@ -42,6 +42,7 @@ void FitCell(const CellSamples& cells, size_t begin, size_t end, const SamplePla
   const size_t k_max = static_cast<size_t>(fit.neighbours);
   std::vector<double> best_d(k_max);
   std::vector<size_t> best_i(k_max);
+  std::vector<Vec3> fit_point(k_max);
   // Planes are fitted at every `stride`-th sample (the anchors; the samples are in random order) and each
   // sample takes the plane of the nearest anchor that agrees with it: a fit per sample costs M² per cell.
   const size_t stride = static_cast<size_t>(fit.anchor_stride);
@@ -73,16 +74,16 @@ void FitCell(const CellSamples& cells, size_t begin, size_t end, const SamplePla
     Vec3 c, n, lambda;
     bool plane = true;
     for (int pass = 0; pass < 2 && plane; ++pass) {
-      auto point = [&](size_t q) -> Vec3 {
+      for (size_t q = 0; q < count; ++q) {
         const size_t b = best_i[q];
-        return pass == 0 ? foot[b] : Vec3(cells.point[begin + b] - cells.distance[begin + b] * n);
-      };
+        fit_point[q] = pass == 0 ? foot[b] : Vec3(cells.point[begin + b] - cells.distance[begin + b] * n);
+      }
       c = Vec3::Zero();
-      for (size_t q = 0; q < count; ++q) c += point(q);
+      for (size_t q = 0; q < count; ++q) c += fit_point[q];
       c /= static_cast<double>(count);
       Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
       for (size_t q = 0; q < count; ++q) {
-        const Vec3 v = point(q) - c;
+        const Vec3 v = fit_point[q] - c;
         cov += v * v.transpose();
       }
       Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig;

@@ -130,7 +130,6 @@ const CellSamples& Optimizer::Analyze(SeedState& s, bool early) {
   const bool planes_change = fit_planes_ != 0 || centre_twin_planes_;
   if (planes_change) planed_cells_ = cached_cells_;
   CellSamples& cells = planes_change ? planed_cells_ : cached_cells_;
-  bool fitted = false;
   if (fit_planes_ != 0) {
     SamplePlanes planes = FitSamplePlanes(cells, SamplePlaneFit{});
     gradient_error_ = planes.median_angle;
@@ -140,14 +139,11 @@ const CellSamples& Optimizer::Analyze(SeedState& s, bool early) {
                            "the zero set %.1f deg: %s", gradient_error_ * 180.0 / M_PI, value_tilt_ * 180.0 / M_PI,
                            fit_planes_ ? "sample planes fitted" : "sample planes from the gradients"));
     }
-    if (fit_planes_ > 0) {
-      UseSamplePlanes(cells, planes);
-      fitted = true;
-    }
+    if (fit_planes_ > 0) UseSamplePlanes(cells, planes);
     monitor_.Debug(Format("sample planes: gradients %.2f deg off (median)", gradient_error_ * 180.0 / M_PI));
   }
   if (centre_twin_planes_)
-    CenterTwinPlanes(cells, projection_.twin_within, projection_.tolerance, fitted);
+    CenterTwinPlanes(cells, projection_.twin_within, projection_.tolerance, fit_planes_ > 0);
   const long n = static_cast<long>(s.position.size());
   std::vector<TangentRank> ranks(static_cast<size_t>(n));
 #pragma omp parallel for schedule(static)
