@@ -103,8 +103,13 @@ std::vector<int> NearestIndices(const std::vector<Vec3>& data, const std::vector
   return nearest;
 }
 
-std::vector<size_t> FarthestPointSubset(const std::vector<Vec3>& points, size_t count, double* covering_radius) {
+std::vector<size_t> FarthestPointSubset(const std::vector<Vec3>& points, size_t count, double* covering_radius,
+                                        const std::vector<double>* spacing) {
   const size_t n = points.size();
+  // Keys are squared distances in the sizing metric, d² / spacing²; spacing <= 1 makes a key no smaller
+  // than the raw squared distance, so the radius search below (raw distances up to the largest key) still
+  // reaches every point a new taken point can come nearer to.
+  const auto inv2 = [&](size_t i) { return spacing ? 1.0 / ((*spacing)[i] * (*spacing)[i]) : 1.0; };
   if (covering_radius) *covering_radius = 0.0;
   std::vector<size_t> taken;
   if (count >= n) {
@@ -117,7 +122,7 @@ std::vector<size_t> FarthestPointSubset(const std::vector<Vec3>& points, size_t 
   // d2[i]: squared distance from point i to the nearest taken point. A max-heap with lazy deletion holds
   // (d2, i) entries; an entry whose value is no longer d2[i] is stale and skipped.
   std::vector<double> d2(n);
-  for (size_t i = 0; i < n; ++i) d2[i] = (points[i] - points[0]).squaredNorm();
+  for (size_t i = 0; i < n; ++i) d2[i] = (points[i] - points[0]).squaredNorm() * inv2(i);
   using Entry = std::pair<double, size_t>;
   const auto lower = [](const Entry& a, const Entry& b) {  // larger distance first, then the lower index
     return a.first < b.first || (a.first == b.first && a.second > b.second);
@@ -147,7 +152,7 @@ std::vector<size_t> FarthestPointSubset(const std::vector<Vec3>& points, size_t 
     tree.index->radiusSearch(qm, found, found_d2, static_cast<float>(d * (1.0 + 1e-5)), params);
     for (size_t k = 0; k < found[0].size(); ++k) {
       const size_t j = found[0][k];
-      const double dj = (points[j] - q).squaredNorm();  // recomputed: the same value however FLANN rounds
+      const double dj = (points[j] - q).squaredNorm() * inv2(j);  // recomputed: the same value however FLANN rounds
       if (dj < d2[j]) {
         d2[j] = dj;
         heap.push({dj, j});

@@ -28,6 +28,10 @@ std::vector<int> NearestIndices(const std::vector<Vec3>& data, const std::vector
 /// taken one, and no two taken points are closer (so the subset is at most twice as sparse as the best
 /// covering of that size, Gonzalez 1985). Exact (a kd-tree bounds each update to the current radius); depends
 /// only on the points. All indices if count >= points.size().
-std::vector<size_t> FarthestPointSubset(const std::vector<Vec3>& points, size_t count, double* covering_radius = nullptr);
+/// With `spacing` (one value in (0, 1] per point), distances from point i are divided by spacing[i]: the
+/// subset is even in that sizing metric, about 1/spacing² times denser where spacing < 1, and the covering
+/// radius is in it too.
+std::vector<size_t> FarthestPointSubset(const std::vector<Vec3>& points, size_t count, double* covering_radius = nullptr,
+                                        const std::vector<double>* spacing = nullptr);
 
 }  // namespace voroudf

@@ -520,6 +520,54 @@ std::vector<Vec3> CreaseNormals(double angle, double share, double wedge, size_t
   return n;
 }
 
+// Cell samples (point, UDF value, gradient) of an exact field in the disc of radius `reach` around `centre` in
+// the xz plane, on a 13 × 13 grid; `foot` maps a point to its nearest surface point.
+struct FakeCell {
+  std::vector<Vec3> point, gradient;
+  std::vector<double> distance;
+};
+template <class Foot>
+FakeCell SampleCell(const Vec3& centre, double reach, Foot foot) {
+  FakeCell c;
+  for (int i = -6; i <= 6; ++i)
+    for (int k = -6; k <= 6; ++k) {
+      const Vec3 p = centre + reach / 6.0 * Vec3(i, 0.37 * ((i + k) % 3), k);
+      const Vec3 f = foot(p);
+      const double d = (p - f).norm();
+      if (d < 1e-9 || (p - centre).norm() > reach) continue;
+      c.point.push_back(p), c.distance.push_back(d), c.gradient.push_back((p - f) / d);
+    }
+  return c;
+}
+
+// A tube narrower than the cell turns its normals by 100° and more within it: rank 2 by the singular values,
+// yet one sheet, whose normal lines all meet the tube's axis. A convex crease's (its face samples' normal
+// lines are parallel) and a crossing of two sheets' are rank 2 and do not meet on one axis.
+TEST(TangentRank, ATubeNarrowerThanTheCellIsACurvedSheetAndACreaseIsNot) {
+  auto test = [](const FakeCell& c) {
+    const TangentRank r = ComputeTangentRank(c.gradient.data(), c.gradient.size(), 0.4);
+    return std::make_pair(r.rank, NormalsMeetOnOneAxis(c.point.data(), c.distance.data(), c.gradient.data(),
+                                                       c.point.size(), r, 0.2));
+  };
+  const double radius = 0.03;  // a tube along y through the origin, the cell's centre on its top
+  const auto tube = SampleCell(Vec3(0, 0, radius), 0.05, [&](const Vec3& p) {
+    const Vec3 q(p.x(), 0.0, p.z());
+    return Vec3(radius * q.normalized().x(), p.y(), radius * q.normalized().z());
+  });
+  EXPECT_EQ(test(tube), std::make_pair(2, true));
+  // A convex 90° edge along y: the quarter space x < 0, z < 0, the cell centred on the edge.
+  const auto edge = SampleCell(Vec3(0, 0, 0), 0.05, [](const Vec3& p) {
+    if (p.x() < 0 && p.z() < 0) return p.x() > p.z() ? Vec3(0, p.y(), p.z()) : Vec3(p.x(), p.y(), 0);
+    return Vec3(std::min(p.x(), 0.0), p.y(), std::min(p.z(), 0.0));
+  });
+  EXPECT_EQ(test(edge), std::make_pair(2, false));
+  // Two planes x = 0 and z = 0 crossing along y.
+  const auto cross = SampleCell(Vec3(0, 0, 0), 0.05, [](const Vec3& p) {
+    return std::abs(p.x()) < std::abs(p.z()) ? Vec3(0, p.y(), p.z()) : Vec3(p.x(), p.y(), 0);
+  });
+  EXPECT_EQ(test(cross), std::make_pair(2, false));
+}
+
 TEST(TangentRank, ShallowCreaseSeenByTheTwoPlaneTestAndCurvedSheetNot) {
   const double deg = M_PI / 180.0, share = SecondPlaneShare(0.4);
   EXPECT_NEAR(share, 0.16 / 1.16, 1e-12);

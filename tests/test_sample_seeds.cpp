@@ -110,23 +110,40 @@ TEST(ThinParts, TheProbeFindsTheRingsThicknessAndNothingElse) {
   SampleSeedsOptions options;
   options.count = 2000;
   const SeedCloud seeds = SampleSeeds(*ring, options, Monitor::Null());
-  // h = 0.05: the gap of 0.1 between sphere and ring is not passed (that needs s > 0.1 / 1.75).
+  // h = 0.05: the probes reach 0.05, the gap of 0.1 between sphere and ring is not seen (that needs s > 0.1 / 1.9).
   const std::vector<double> t = ProbeThickness(*ring, seeds.position, seeds.normal, 0.05);
   int ring_points = 0;
   for (size_t i = 0; i < seeds.size(); ++i) {
     if (OnRing(seeds.position[i])) {
       ++ring_points;
-      EXPECT_GE(t[i], 0.06 / 1.75 * 1.25 - 1e-9) << seeds.position[i].transpose();  // tube diameter 0.06
-      EXPECT_LE(t[i], 0.06 * 1.25 * 2 / 1.75 + 1e-9) << seeds.position[i].transpose();
+      // The tube is 0.06 across along every normal; the first probe to see it is s in (0.06/1.9, √2 · 0.06/1.9].
+      EXPECT_GE(t[i], 1.6 * 0.06 / 1.9 - 1e-9) << seeds.position[i].transpose();
+      EXPECT_LE(t[i], 1.6 * std::sqrt(2.0) * 0.06 / 1.9 + 1e-9) << seeds.position[i].transpose();
     } else {
       EXPECT_TRUE(std::isinf(t[i])) << seeds.position[i].transpose();  // 0.7 across
     }
   }
   EXPECT_GT(ring_points, 100);
-  // A cube's faces meet its neighbours beside, not opposite: no concave or convex edge is a thin part.
+  // A cube's faces meet its neighbours beside, not opposite: no concave or convex edge is a thin part (h = 0.4:
+  // the probes reach 0.4, short of the opposite face's 1 / 1.9).
   const auto cube = MakeShape("cube");
   const SeedCloud cube_seeds = SampleSeeds(*cube, options, Monitor::Null());
   for (double thickness : ProbeThickness(*cube, cube_seeds.position, cube_seeds.normal, 0.4)) EXPECT_TRUE(std::isinf(thickness));
+  // With h = 0.8 the probes see the opposite face, 1 away, from the middle of a face (nearer its edges a side
+  // face is nearest at the probes): thickness in (1.6 / 1.9, 1.6].
+  const std::vector<double> wide = ProbeThickness(*cube, cube_seeds.position, cube_seeds.normal, 0.8);
+  int middle = 0;
+  for (size_t i = 0; i < cube_seeds.size(); ++i) {
+    Eigen::Index axis = 0;
+    cube_seeds.normal[i].cwiseAbs().maxCoeff(&axis);
+    Vec3 lateral = cube_seeds.position[i].cwiseAbs();
+    lateral[axis] = 0.0;
+    if (lateral.maxCoeff() > 0.25) continue;
+    ++middle;
+    EXPECT_GT(wide[i], 1.6 / 1.9);
+    EXPECT_LE(wide[i], 1.6);
+  }
+  EXPECT_GT(middle, 100);
 }
 
 TEST(ThinParts, TheBoostMovesSeedsToTheRingAndKeepsTheCount) {
@@ -147,6 +164,10 @@ TEST(ThinParts, TheBoostMovesSeedsToTheRingAndKeepsTheCount) {
   EXPECT_GT(ring_share(boosted), 1.5 * ring_share(uniform));
   const SeedCloud again = SampleSeeds(*ring, options, Monitor::Null());
   EXPECT_EQ(again.position, boosted.position);
+  options.spread_pool = 4;  // farthest apart in the thin parts' sizing: as many on the ring, evenly spaced
+  const SeedCloud spread = SampleSeeds(*ring, options, Monitor::Null());
+  EXPECT_EQ(spread.size(), options.count);
+  EXPECT_GT(ring_share(spread), 1.5 * ring_share(uniform));
   // Weighted choice: heavier indices are chosen more often, and exactly `count` of them.
   std::vector<double> w(1000, 1.0);
   for (size_t i = 500; i < 1000; ++i) w[i] = 4.0;
@@ -166,8 +187,8 @@ TEST(SampleSeeds, BadOptionsAreUsageErrors) {
   options.proj_tol_rel = 1e-5;
   options.thin_boost = 0.5;
   EXPECT_THROW(options.Check(), UsageError);
-  options.thin_boost = 2;  // both choose from a pool
-  EXPECT_THROW(options.Check(), UsageError);
+  options.thin_boost = 2;  // with the spread pool: farthest apart in the thin parts' sizing
+  EXPECT_NO_THROW(options.Check());
   options.spread_pool = 1;
   EXPECT_NO_THROW(options.Check());
   options.spread_pool = 0;
@@ -175,16 +196,19 @@ TEST(SampleSeeds, BadOptionsAreUsageErrors) {
 }
 
 // Farthest-point sampling the plain way: O(n) per pick.
-std::vector<size_t> NaiveFarthest(const std::vector<Vec3>& p, size_t count) {
+std::vector<size_t> NaiveFarthest(const std::vector<Vec3>& p, size_t count, const std::vector<double>& spacing = {}) {
+  auto metric = [&](size_t i, size_t j) {
+    return (p[i] - p[j]).squaredNorm() / (spacing.empty() ? 1.0 : spacing[i] * spacing[i]);
+  };
   std::vector<double> d(p.size());
-  for (size_t i = 0; i < p.size(); ++i) d[i] = (p[i] - p[0]).squaredNorm();
+  for (size_t i = 0; i < p.size(); ++i) d[i] = metric(i, 0);
   std::vector<size_t> taken{0};
   while (taken.size() < count) {
     size_t best = 0;
     for (size_t i = 1; i < p.size(); ++i)
       if (d[i] > d[best]) best = i;  // ties: the lower index
     taken.push_back(best);
-    for (size_t i = 0; i < p.size(); ++i) d[i] = std::min(d[i], (p[i] - p[best]).squaredNorm());
+    for (size_t i = 0; i < p.size(); ++i) d[i] = std::min(d[i], metric(i, best));
   }
   std::sort(taken.begin(), taken.end());
   return taken;
@@ -212,6 +236,15 @@ TEST(Spread, FarthestPointSubsetIsTheGreedyChoiceAndCoversAtItsRadius) {
     EXPECT_LE(d, radius + 1e-12);
   }
   EXPECT_EQ(FarthestPointSubset(points, 5000).size(), points.size());
+  // In a sizing metric (distances from points with x < 0.3 divided by 0.5), on a plane: the same greedy
+  // choice, and about 1/0.5² = 4 times as dense there as elsewhere.
+  for (Vec3& p : points) p.z() = 0.0;
+  std::vector<double> spacing(points.size());
+  for (size_t i = 0; i < points.size(); ++i) spacing[i] = points[i].x() < 0.3 ? 0.5 : 1.0;
+  const std::vector<size_t> sized = FarthestPointSubset(points, 250, nullptr, &spacing);
+  EXPECT_EQ(sized, NaiveFarthest(points, 250, spacing));
+  const double dense = static_cast<double>(std::count_if(sized.begin(), sized.end(), [&](size_t i) { return points[i].x() < 0.3; }));
+  EXPECT_NEAR(dense / 0.3 / ((250.0 - dense) / 0.7), 4.0, 1.0);
 }
 
 TEST(Spread, TheSpreadPoolStartsTheSeedsEvenlySpacedOnTheSurface) {

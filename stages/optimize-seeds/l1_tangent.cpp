@@ -399,6 +399,64 @@ double SecondPlaneShare(double tau) { return tau * tau / (1.0 + tau * tau); }
 
 double BlindCreaseAngle(double tau) { return 2.0 * std::atan(tau); }
 
+namespace {
+
+// Axis angles in (−π/2, π/2] around the dominant direction v₁ in the plane of v₁ and v₂ (a normal and its
+// opposite are one plane), sorted.
+void SortedAxisAngles(const Vec3* normals, size_t count, const TangentRank& r, std::vector<double>& phi) {
+  phi.clear();
+  phi.reserve(count);
+  for (size_t m = 0; m < count; ++m) {
+    double a = normals[m].dot(r.v.col(0)), b = normals[m].dot(r.v.col(1));
+    if (a < 0.0) a = -a, b = -b;
+    if (a == 0.0 && b == 0.0) continue;
+    phi.push_back(std::atan2(b, a));
+  }
+  std::sort(phi.begin(), phi.end());
+}
+
+}  // namespace
+
+bool NormalsMeetOnOneAxis(const Vec3* points, const double* distances, const Vec3* gradients, size_t count,
+                          const TangentRank& r, double max_residual) {
+  // Each line m, in the plane's coordinates: a_m · c = b_m, a_m the unit normal of the line (its direction
+  // turned by 90°), b_m = a_m · f_m, f_m the foot point. Least squares for c: (Σ a aᵀ) c = Σ a b.
+  thread_local std::vector<Eigen::Vector2d> foot, across;
+  foot.clear(), across.clear();
+  const Vec3 e1 = r.v.col(0), e2 = r.v.col(1);
+  for (size_t m = 0; m < count; ++m) {
+    const Eigen::Vector2d u(gradients[m].dot(e1), gradients[m].dot(e2));
+    if (u.norm() < 0.5) continue;  // no direction in the plane (or no gradient)
+    const Vec3 f = points[m] - distances[m] * gradients[m];
+    foot.emplace_back(f.dot(e1), f.dot(e2));
+    across.emplace_back(-u.y() / u.norm(), u.x() / u.norm());
+  }
+  const size_t n = foot.size();
+  if (n < 8) return false;
+  Eigen::Matrix2d ata = Eigen::Matrix2d::Zero();
+  Eigen::Vector2d atb = Eigen::Vector2d::Zero(), mean = Eigen::Vector2d::Zero();
+  for (size_t m = 0; m < n; ++m) {
+    ata += across[m] * across[m].transpose();
+    atb += across[m] * across[m].dot(foot[m]);
+    mean += foot[m];
+  }
+  mean /= static_cast<double>(n);
+  // Parallel lines (a flat sheet) have no centre: the smaller eigenvalue of Σ a aᵀ is near 0.
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(ata);
+  if (eig.eigenvalues()(0) < 1e-3 * static_cast<double>(n)) return false;
+  const Eigen::Vector2d c = ata.ldlt().solve(atb);
+  double residual2 = 0.0, spread2 = 0.0;
+  std::vector<double> radius(n);
+  for (size_t m = 0; m < n; ++m) {
+    residual2 += std::pow(across[m].dot(c) - across[m].dot(foot[m]), 2);
+    spread2 += (foot[m] - mean).squaredNorm();
+    radius[m] = (foot[m] - c).norm();
+  }
+  const double residual = std::sqrt(residual2 / static_cast<double>(n)), spread = std::sqrt(spread2 / static_cast<double>(n));
+  std::nth_element(radius.begin(), radius.begin() + static_cast<std::ptrdiff_t>(n / 2), radius.end());
+  return spread > 0.0 && residual < max_residual * spread && radius[n / 2] >= 0.5 * spread;
+}
+
 bool SeesTwoPlanes(const Vec3* normals, size_t count, const TangentRank& r, double min_angle, double max_angle,
                    double min_share, double min_contrast) {
   const size_t min_group = static_cast<size_t>(std::ceil(min_share * static_cast<double>(count)));
@@ -411,19 +469,10 @@ bool SeesTwoPlanes(const Vec3* normals, size_t count, const TangentRank& r, doub
   const double root = std::sqrt(std::max(0.0, 1.0 - 4.0 * p));
   const double s1 = r.singular_values[0], s2 = r.singular_values[1];
   if (2.0 * s2 * s2 * (1.0 + root) < (1.0 - root) * s1 * s1) return false;
-  // Axis angles in (−π/2, π/2] around the dominant direction v₁: a normal and its opposite are one plane.
   thread_local std::vector<double> phi;
-  phi.clear();
-  phi.reserve(count);
-  for (size_t m = 0; m < count; ++m) {
-    double a = normals[m].dot(r.v.col(0)), b = normals[m].dot(r.v.col(1));
-    if (a < 0.0) a = -a, b = -b;
-    if (a == 0.0 && b == 0.0) continue;
-    phi.push_back(std::atan2(b, a));
-  }
+  SortedAxisAngles(normals, count, r, phi);
   const size_t n = phi.size();
   if (n < 2 * min_group) return false;
-  std::sort(phi.begin(), phi.end());
   double sum = 0.0, sum_sq = 0.0;
   for (double x : phi) sum += x, sum_sq += x * x;
   // Prefix sums give each split's within-group sum of squares in O(1).

@@ -137,4 +137,16 @@ double BlindCreaseAngle(double tau);
 bool SeesTwoPlanes(const Vec3* normals, size_t count, const TangentRank& r, double min_angle, double max_angle,
                    double min_share, double min_contrast);
 
+/// Curved-sheet test (not in the paper; docs/optimize-seeds.md, "Curved sheets"): whether the cell's normal
+/// lines (through each sample's foot point x − d·n, along n) pass near one axis along the null direction
+/// t = r.v.col(2), at a distance from it comparable to the foot points' spread — the samples of one sheet
+/// curved round that axis: a tube, a rod or a fillet narrower than the cell. In the plane of v₁ and v₂ the
+/// centre c minimises the squared distances from c to the lines; true when their RMS is below `max_residual`
+/// × the foot points' RMS spread and the median distance from c to the foot points is at least half that
+/// spread. A crease's face samples have parallel normal lines that no one point is near; the normal lines of
+/// a convex edge's wedge samples meet on the edge, where their foot points lie.
+/// \param r the cell's TangentRank (rank 2: v's third column is the axis)
+bool NormalsMeetOnOneAxis(const Vec3* points, const double* distances, const Vec3* gradients, size_t count,
+                          const TangentRank& r, double max_residual);
+
 }  // namespace voroudf

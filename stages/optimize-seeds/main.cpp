@@ -37,6 +37,7 @@ int main(int argc, char** argv) {
   app.add_option("--crease-angle-deg", o.crease_angle_deg, "a sheet cell whose normals show two planes this many degrees apart (below 2 atan(--rank-threshold)) is a crease (0: off)");
   app.add_option("--sample-planes", o.sample_planes, "gradient: a cell sample's tangent plane is its gradient's (the paper); fit: fitted to the surface points the cell's samples point at (gradient errors); auto: fit when the gradients are off those planes by more than 8 deg and more than the value errors explain");
   app.add_option("--rank-noise", o.rank_noise, "take the normal spread no surface explains (gradient errors) out of the rank test");
+  app.add_option("--curved-sheets", o.curved_sheets, "a rank-2 cell whose normal lines meet on one axis is a sheet curved within it (a tube or rod narrower than a cell; use with sample-seeds --thin-boost)");
   app.add_option("--cell-knn", o.cell_knn, "cells are bounded by a ball sized by the distance to this nearest seed");
   app.add_option("--cell-radius-factor", o.cell_radius_factor, "ball radius / distance to the --cell-knn-th seed");
   app.add_option("--sigma-max-spacing", o.sigma_max_spacing, "kernel width at most this x mean seed spacing (0: no cap)");

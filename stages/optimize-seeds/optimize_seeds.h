@@ -45,6 +45,10 @@ struct OptimizeSeedsOptions {
   /// spread no surface explains: gradient errors), so that a noisy sheet is not a crease; off (default): the
   /// paper's test. Off by default: on feature-dense parts the median s_3/s_1 is geometry, not noise (docs).
   bool rank_noise = false;
+  /// --curved-sheets: a rank-2 cell whose samples' normal lines meet on one axis is one sheet curved within
+  /// the cell (a tube or a rod narrower than it; NormalsMeetOnOneAxis), rank 1. For parts thinner than a
+  /// spacing, with sample-seeds --thin-boost; off by default: over the shared data it measures no better.
+  bool curved_sheets = false;
   /// --sample-planes: gradient: each cell sample's tangent plane is its gradient's (the paper); fit: fitted to
   /// the foot points of the cell's samples (FitSamplePlanes; fields with gradient errors); auto: fit when the
   /// first cells' gradients are off those planes by more than sample_planes_auto_deg and by more than the

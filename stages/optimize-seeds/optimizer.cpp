@@ -11,6 +11,9 @@ namespace voroudf {
 namespace {
 // SeesTwoPlanes' contrast: between a uniform spread's 3.46 (one curved sheet) and the > 9 of two planes.
 constexpr double kCreaseContrast = 6.0;
+// NormalsMeetOnOneAxis' residual: a tube's normal lines meet its axis exactly with exact gradients; a
+// crease's face samples miss any common point by a good part of the spread.
+constexpr double kCurvedSheetResidual = 0.2;
 }  // namespace
 
 double Optimizer::Project(SeedState& s, const std::vector<Vec3>& previous, std::vector<Vec3> moved, double min_separation) {
@@ -163,6 +166,12 @@ const CellSamples& Optimizer::Analyze(SeedState& s, bool early) {
                       cells.sample_offset[i + 1] - cells.sample_offset[i], r, crease_angle_, crease_max_angle_,
                       crease_share_, kCreaseContrast))
       r.rank = 2;
+    else if (r.rank == 2 && options_.curved_sheets && NormalsMeetOnOneAxis(cells.point.data() + cells.sample_offset[i],
+                                                 cells.distance.data() + cells.sample_offset[i],
+                                                 cells.gradient.data() + cells.sample_offset[i],
+                                                 cells.sample_offset[i + 1] - cells.sample_offset[i], r,
+                                                 kCurvedSheetResidual))
+      r.rank = 1;
     MoveSpace& space = s.space[i];
     if (r.rank == 0) {
       // No usable sample (an empty cell within the budget): move in the tangent plane of the seed's own

@@ -23,7 +23,7 @@ int main(int argc, char** argv) {
   app.add_option("--proj-tol-rel", options.proj_tol_rel,
                  "projection tolerance on d, relative to the domain box diagonal");
   app.add_option("--proj-max-iters", options.proj_max_iters, "projection steps before a seed is dropped");
-  app.add_option("--thin-boost", options.thin_boost, "up to this many times the seeds where the part is thinner than two spacings (1: uniform)");
+  app.add_option("--thin-boost", options.thin_boost, "up to this many times the seeds where the part is thinner than two spacings, about nine round a tube (1: uniform)");
   app.add_option("--spread-pool", options.spread_pool,
                  "draw this many times --count points and keep the --count farthest apart (1: uniform draws, the paper)");
   app.add_option("--proj-floor-rel", options.proj_floor_rel, voroudf::kProjFloorRelHelp);

@@ -22,7 +22,6 @@ void SampleSeedsOptions::Check() const {
   if (!(dedup_rel >= 0.0 && dedup_rel < 0.1)) throw UsageError("--dedup-rel must be in [0, 0.1)");
   if (!(thin_boost >= 1.0 && thin_boost <= 64.0)) throw UsageError("--thin-boost must be in [1, 64]");
   if (spread_pool < 1 || spread_pool > 64) throw UsageError("--spread-pool must be in [1, 64]");
-  if (spread_pool > 1 && thin_boost > 1.0) throw UsageError("--thin-boost needs --spread-pool 1 (both choose the seeds from a pool of draws)");
 }
 
 namespace {
@@ -122,44 +121,45 @@ double SpacingOf(const std::vector<Vec3>& p) {
   return 2.0 * nn[nn.size() / 2];
 }
 
-// --thin-boost: `converged` holds a pool of ceil(boost) x count projected draws; chooses count of them with
-// probabilities growing with ThinSeedWeights (thin_sizing.h), in pool order.
-std::vector<size_t> ChooseForThinParts(const Udf& udf, const SampleSeedsOptions& options, const std::vector<size_t>& converged,
-                                       const std::vector<Vec3>& points, const std::vector<Vec3>& normal, Monitor& monitor) {
+// Chooses `count` of the projected draws `converged`: with --thin-boost the relative spacing s = 1/√w of
+// ThinSeedWeights (thin_sizing.h) at each draw, then with --spread-pool the count farthest apart in the metric
+// d / s (even where the part is thick, about w times denser where it is thin), without it count at random
+// with chances ∝ w. In pool order.
+std::vector<size_t> ChooseSeeds(const Udf& udf, const SampleSeedsOptions& options, const std::vector<size_t>& converged,
+                                const std::vector<Vec3>& points, const std::vector<Vec3>& normal, Monitor& monitor) {
   std::vector<Vec3> p(converged.size()), n(converged.size());
   for (size_t k = 0; k < converged.size(); ++k) p[k] = points[converged[k]], n[k] = normal[converged[k]];
-  // The spacing of `count` uniform seeds, from the pool's.
-  const double h = SpacingOf(p) * std::sqrt(static_cast<double>(p.size()) / static_cast<double>(options.count));
-  const std::vector<double> thickness = ProbeThickness(udf, p, n, h);
-  const std::vector<double> weight = ThinSeedWeights(thickness, h, options.thin_boost);
-  const std::vector<size_t> chosen = ChooseWeighted(weight, options.count, options.seed);
-  std::vector<size_t> keep(chosen.size());
-  size_t thin = 0, thin_chosen = 0;
-  for (size_t k = 0; k < chosen.size(); ++k) keep[k] = converged[chosen[k]], thin_chosen += weight[chosen[k]] > 1.0;
-  for (double w : weight) thin += w > 1.0;
+  std::vector<double> weight, spacing;
   char line[300];
-  std::snprintf(line, sizeof line,
-                "thin parts: %zu of %zu pool points lie where the part is thinner than 2h (h = %.3g, the spacing of "
-                "count uniform seeds); %zu of the %zu seeds chosen there (uniform: %.0f)",
-                thin, p.size(), h, thin_chosen, chosen.size(),
-                static_cast<double>(thin) * static_cast<double>(chosen.size()) / static_cast<double>(p.size()));
-  monitor.Info(line);
-  return keep;
-}
-
-// --spread-pool: `converged` holds spread_pool x count projected draws; chooses the count farthest apart.
-std::vector<size_t> ChooseSpread(const SampleSeedsOptions& options, const std::vector<size_t>& converged,
-                                 const std::vector<Vec3>& points, Monitor& monitor) {
-  std::vector<Vec3> p(converged.size());
-  for (size_t k = 0; k < converged.size(); ++k) p[k] = points[converged[k]];
-  double radius = 0.0;
-  const std::vector<size_t> chosen = FarthestPointSubset(p, options.count, &radius);
+  if (options.thin_boost > 1.0) {
+    // The spacing of `count` uniform seeds, from the pool's.
+    const double h = SpacingOf(p) * std::sqrt(static_cast<double>(p.size()) / static_cast<double>(options.count));
+    weight = ThinSeedWeights(ProbeThickness(udf, p, n, h), h, options.thin_boost);
+    for (double w : weight) spacing.push_back(1.0 / std::sqrt(w));
+    const size_t thin = static_cast<size_t>(std::count_if(weight.begin(), weight.end(), [](double w) { return w > 1.0; }));
+    std::snprintf(line, sizeof line,
+                  "thin parts: %zu of %zu pool points lie where the part is thinner than 2h (h = %.3g, the spacing of "
+                  "count uniform seeds)", thin, p.size(), h);
+    monitor.Info(line);
+  }
+  std::vector<size_t> chosen;
+  if (options.spread_pool > 1) {
+    double radius = 0.0;
+    chosen = FarthestPointSubset(p, options.count, &radius, spacing.empty() ? nullptr : &spacing);
+    std::snprintf(line, sizeof line, "spread: %zu of %zu projected draws chosen farthest apart%s; every draw within %.3g of one",
+                  chosen.size(), p.size(), spacing.empty() ? "" : " (distances / the thin parts' spacing)", radius);
+    monitor.Info(line);
+  } else {
+    chosen = ChooseWeighted(weight, options.count, options.seed);
+  }
+  if (!weight.empty()) {
+    size_t thin_chosen = 0;
+    for (size_t k : chosen) thin_chosen += weight[k] > 1.0;
+    std::snprintf(line, sizeof line, "thin parts: %zu of the %zu seeds chosen there", thin_chosen, chosen.size());
+    monitor.Info(line);
+  }
   std::vector<size_t> keep(chosen.size());
   for (size_t k = 0; k < chosen.size(); ++k) keep[k] = converged[chosen[k]];
-  char line[200];
-  std::snprintf(line, sizeof line, "spread: %zu of %zu projected draws chosen farthest apart; every draw within %.3g of one",
-                chosen.size(), p.size(), radius);
-  monitor.Info(line);
   return keep;
 }
 
@@ -170,9 +170,8 @@ SeedCloud SampleSeeds(const Udf& udf, const SampleSeedsOptions& options, Monitor
   const Box box = udf.Domain();
   monitor.Info("domain box " + FormatBox(box) + ", diagonal " + std::to_string(box.Diagonal()));
   SampleSeedsOptions draw_options = options;
-  if (options.thin_boost > 1.0)  // a pool to choose from (ChooseForThinParts)
-    draw_options.count = static_cast<size_t>(std::ceil(options.thin_boost)) * options.count;
-  if (options.spread_pool > 1) draw_options.count = static_cast<size_t>(options.spread_pool) * options.count;
+  // A pool to choose from (ChooseSeeds): ceil(B) times denser for thin parts, spread_pool times for the spread.
+  draw_options.count = static_cast<size_t>(std::ceil(options.thin_boost)) * static_cast<size_t>(options.spread_pool) * options.count;
   std::vector<Vec3> points = DrawInBand(udf, box, draw_options, monitor);
   ProjectionOptions proj =
       RelativeProjection(box.Diagonal(), options.proj_tol_rel, options.proj_floor_rel, options.proj_max_iters);
@@ -182,9 +181,8 @@ SeedCloud SampleSeeds(const Udf& udf, const SampleSeedsOptions& options, Monitor
   std::vector<size_t> converged;
   for (size_t i = 0; i < points.size(); ++i)
     if (r.converged[i]) converged.push_back(i);
-  if (options.thin_boost > 1.0 && converged.size() > 1)
-    converged = ChooseForThinParts(udf, options, converged, points, r.gradient, monitor);
-  if (options.spread_pool > 1) converged = ChooseSpread(options, converged, points, monitor);
+  if ((options.thin_boost > 1.0 || options.spread_pool > 1) && converged.size() > 1)
+    converged = ChooseSeeds(udf, options, converged, points, r.gradient, monitor);
   const std::vector<size_t> kept = KeepDistinct(points, converged, options.dedup_rel * box.Diagonal());
 
   SeedCloud seeds;

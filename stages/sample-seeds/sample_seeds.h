@@ -30,13 +30,13 @@ struct SampleSeedsOptions {
   /// --proj-twin-factor: zero sheets closer than this x the field's measured floor are one surface
   /// (common/projection.h, MergeTwinSheets); exact fields have no floor. 0: off.
   double proj_twin_factor = kProjTwinFactor;
-  /// --thin-boost B: draw ceil(B) x count points and choose count of them, up to B times likelier where the
-  /// part is thinner than 2 spacings (ThinSeedWeights in thin_sizing.h), so flat parts give seeds to thin ones;
-  /// 1: uniform, the paper.
+  /// --thin-boost B: a pool ceil(B) times larger, from which the count are chosen up to B times denser where
+  /// the part is thinner than 2 spacings (ThinSeedWeights in thin_sizing.h), so flat parts give seeds to thin
+  /// ones; 1: uniform, the paper.
   double thin_boost = 1.0;
   /// --spread-pool K: draw K x count points and keep the count of them farthest apart (farthest-point sampling,
   /// FarthestPointSubset in common/knn.h), so the seeds start evenly spaced and optimize-seeds' repulsion has
-  /// less to do; 1: the paper's uniform draws. Not with thin_boost > 1 (both choose from the pool).
+  /// less to do; 1: the paper's uniform draws. With thin_boost > 1, farthest apart in the thin parts' sizing.
   int spread_pool = 4;
 
   /// Throws UsageError for values that cannot work.

@@ -8,15 +8,26 @@
 
 namespace voroudf {
 
+namespace {
+// The spacing asked for where the part is thin, as a share of its thickness: a tube 2r across gets
+// 2πr / (2r/3) ≈ 9 seeds around it, which build-gvd's dual closes (six leave it open in some draws).
+constexpr double kThinSpacing = 1.0 / 3.0;
+double ProbeLength(double h, int k) { return h * std::pow(2.0, -0.5 * k); }
+}  // namespace
+
 std::vector<double> ProbeThickness(const Udf& udf, const std::vector<Vec3>& points, const std::vector<Vec3>& normals,
                                    double h) {
-  constexpr int kLengths = 4;  // h, h/2, h/4, h/8
+  // Lengths h·2^(−k/2): a probe flags a sheet D away along the normal when s lies in (D/1.9, D) (past the
+  // medial point, before the far sheet), a range wider than the √2 between lengths, so no D in
+  // (0.17 h, 1.9 h) falls between two probes. Longer probes would also see gaps between parts (a UDF has no
+  // inside), such as the one between shape:sphere-ring's sphere and ring, and take seeds there.
+  constexpr int kLengths = 8;
   const size_t n = points.size();
   std::vector<Vec3> probes(n * 2 * kLengths);
   for (size_t i = 0; i < n; ++i)
     for (int k = 0; k < kLengths; ++k)
       for (int side = 0; side < 2; ++side)
-        probes[(i * kLengths + k) * 2 + side] = points[i] + (side ? -1.0 : 1.0) * std::ldexp(h, -k) * normals[i];
+        probes[(i * kLengths + k) * 2 + side] = points[i] + (side ? -1.0 : 1.0) * ProbeLength(h, k) * normals[i];
   std::vector<double> d;
   std::vector<Vec3> g;
   udf.Evaluate(probes, d, g);
@@ -24,11 +35,11 @@ std::vector<double> ProbeThickness(const Udf& udf, const std::vector<Vec3>& poin
   for (size_t i = 0; i < n; ++i) {
     if (normals[i].squaredNorm() == 0.0) continue;
     for (int k = 0; k < kLengths; ++k) {
-      const double s = std::ldexp(h, -k);
+      const double s = ProbeLength(h, k);
       for (int side = 0; side < 2; ++side) {
         const size_t q = (i * kLengths + k) * 2 + side;
         const Vec3 out = (side ? -1.0 : 1.0) * normals[i];
-        if (d[q] < 0.75 * s && g[q].dot(out) < -0.5) thickness[i] = 1.25 * s;
+        if (d[q] < 0.9 * s && g[q].dot(out) < -0.5) thickness[i] = 1.6 * s;
       }
     }
   }
@@ -38,7 +49,7 @@ std::vector<double> ProbeThickness(const Udf& udf, const std::vector<Vec3>& poin
 std::vector<double> ThinSeedWeights(const std::vector<double>& thickness, double h, double max_boost) {
   std::vector<double> weight(thickness.size(), 1.0);
   for (size_t i = 0; i < thickness.size(); ++i)
-    if (std::isfinite(thickness[i])) weight[i] = std::clamp(std::pow(h / (0.5 * thickness[i]), 2), 1.0, max_boost);
+    if (std::isfinite(thickness[i])) weight[i] = std::clamp(std::pow(h / (kThinSpacing * thickness[i]), 2), 1.0, max_boost);
   return weight;
 }
 
