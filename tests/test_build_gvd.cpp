@@ -536,6 +536,30 @@ TEST(BuildGvd, SameResultWhateverTheThreadCount) {
   EXPECT_EQ(one.samples.edges, many.samples.edges);
 }
 
+// Seeds packed round shape:sphere-ring's thin tube (sample-seeds --thin-boost) have small balls: shared out by
+// area they get few samples each, as many per seed with --ball-shares seed.
+TEST(BuildGvd, BallSharesBySeedKeepTheSamplesPerRegionWhereSeedsAreDense) {
+  const auto udf = MakeShape("sphere-ring");
+  SampleSeedsOptions so;
+  so.count = 500;
+  so.thin_boost = 6;
+  const SeedCloud seeds = SampleSeeds(*udf, so, Monitor::Null());
+  auto ratio = [&](const std::string& shares) {  // mean samples per tube region / per sphere region
+    BuildGvdOptions o;
+    o.ball_shares = shares;
+    const GvdResult r = BuildGvd(*udf, seeds, o, false, Monitor::Null());
+    double tube = 0, sphere = 0, tube_seeds = 0, sphere_seeds = 0;
+    for (const Vec3& p : seeds.position) (p.norm() > 0.42 ? tube_seeds : sphere_seeds) += 1;
+    for (size_t i = 0; i < r.samples.size(); ++i)
+      if (r.samples.label[i] >= 0) (seeds.position[static_cast<size_t>(r.samples.label[i])].norm() > 0.42 ? tube : sphere) += 1;
+    return (tube / tube_seeds) / (sphere / sphere_seeds);
+  };
+  const double area = ratio("area"), per_seed = ratio("seed");
+  std::printf("samples per tube region / per sphere region: %.2f by area, %.2f by seed\n", area, per_seed);
+  EXPECT_LT(area, 0.4);
+  EXPECT_GT(per_seed, 0.6);
+}
+
 TEST(BuildGvd, BadOptionsAndEmptySeedsAreRefused) {
   BuildGvdOptions o;
   o.knn = 1;
@@ -548,6 +572,9 @@ TEST(BuildGvd, BadOptionsAndEmptySeedsAreRefused) {
   EXPECT_THROW(o.Check(), UsageError);
   o = BuildGvdOptions{};
   o.eps_grad_wall = 0;
+  EXPECT_THROW(o.Check(), UsageError);
+  o = BuildGvdOptions{};
+  o.ball_shares = "volume";
   EXPECT_THROW(o.Check(), UsageError);
   const auto udf = MakeShape("sphere");
   EXPECT_THROW(BuildGvd(*udf, SeedCloud{}, BuildGvdOptions{}, false, Monitor::Null()), InputError);

@@ -71,6 +71,7 @@ void BuildGvdOptions::Check() const {
   if (!(eps_grad_both > 0.0 && eps_grad_both <= 1.0)) throw UsageError("--eps-grad-both must be in (0, 1]");
   if (!(eps_grad_wall > 0.0 && eps_grad_wall <= 1.0)) throw UsageError("--eps-grad-wall must be in (0, 1]");
   if (curve_samples != "tangent" && curve_samples != "ball") throw UsageError("--curve-samples must be tangent or ball");
+  if (ball_shares != "area" && ball_shares != "seed") throw UsageError("--ball-shares must be area or seed");
   CheckRelativeProjection(proj_tol_rel, proj_floor_rel, proj_max_iters, proj_twin_factor);
 }
 
@@ -112,14 +113,17 @@ std::vector<Vec3> DrawSamples(const SeedCloud& seeds, const Box& box, const Buil
   const size_t in_space = static_cast<size_t>(std::llround(options.space_fraction * static_cast<double>(total)));
   // Each seed's ball gets samples in proportion to radius^2, the area its ball covers on a sheet, so the
   // sample density on the surface is even where the seeds are not (e.g. before optimisation, or on a torus'
-  // saddle, where uniform draws are sparse); ball_end[s] is one past seed s's last ball sample.
+  // saddle, where uniform draws are sparse); with --ball-shares seed, as many per seed, so that seeds packed
+  // closer on purpose keep their regions' samples. ball_end[s] is one past seed s's last ball sample.
   std::vector<size_t> ball_end(num_seeds);
   {
+    const bool per_seed = options.ball_shares == "seed";
+    auto weight = [&](size_t s) { return per_seed ? 1.0 : radius[s] * radius[s]; };
     double weight_total = 0.0;
-    for (size_t s = 0; s < num_seeds; ++s) weight_total += radius[s] * radius[s];
+    for (size_t s = 0; s < num_seeds; ++s) weight_total += weight(s);
     double prefix = 0.0;
     for (size_t s = 0; s < num_seeds; ++s) {
-      prefix += radius[s] * radius[s];
+      prefix += weight(s);
       ball_end[s] = static_cast<size_t>(std::llround(static_cast<double>(total - in_space) * prefix / weight_total));
     }
     ball_end[num_seeds - 1] = total - in_space;

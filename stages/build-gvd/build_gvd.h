@@ -31,6 +31,11 @@ struct BuildGvdOptions {
   /// the tangent plane where they landed, for an even density on each sheet up to where sheets cross;
   /// "ball", every ball sample as it lands.
   std::string curve_samples = "tangent";
+  /// --ball-shares: how the ball samples are shared out among the seeds. "area": in proportion to the
+  /// ball's radius², an even density on the surface wherever the seeds are; "seed": the same number per
+  /// seed, a density that follows the seeds' (seeds packed round a thin part, sample-seeds --thin-boost,
+  /// keep as many samples per Voronoi region as elsewhere).
+  std::string ball_shares = "area";
   /// Radius of the ball around each seed, as a multiple of the distance to its 6th-nearest seed (about one
   /// seed spacing on a sheet) (--ball-scale).
   double ball_scale = 1.0;

@@ -27,6 +27,10 @@ int main(int argc, char** argv) {
                  "tangent: curve and corner seeds' ball samples drawn again in the tangent plane where they landed "
                  "(even density up to where sheets cross); ball: as they land")
       ->check(CLI::IsMember({"tangent", "ball"}));
+  app.add_option("--ball-shares", options.ball_shares,
+                 "area: ball samples shared out by ball area (even density on the surface); seed: as many per seed "
+                 "(a density that follows the seeds', with sample-seeds --thin-boost)")
+      ->check(CLI::IsMember({"area", "seed"}));
   app.add_option("--ball-scale", options.ball_scale, "ball radius around a seed / distance to its 6th-nearest seed");
   app.add_option("--knn", options.knn, "neighbours per sample in the kNN graph");
   app.add_option("--eps-udf-rel", options.eps_udf_rel, "prune edges with midpoint UDF above this x diagonal");
