@@ -399,24 +399,6 @@ double SecondPlaneShare(double tau) { return tau * tau / (1.0 + tau * tau); }
 
 double BlindCreaseAngle(double tau) { return 2.0 * std::atan(tau); }
 
-namespace {
-
-// Axis angles in (−π/2, π/2] around the dominant direction v₁ in the plane of v₁ and v₂ (a normal and its
-// opposite are one plane), sorted.
-void SortedAxisAngles(const Vec3* normals, size_t count, const TangentRank& r, std::vector<double>& phi) {
-  phi.clear();
-  phi.reserve(count);
-  for (size_t m = 0; m < count; ++m) {
-    double a = normals[m].dot(r.v.col(0)), b = normals[m].dot(r.v.col(1));
-    if (a < 0.0) a = -a, b = -b;
-    if (a == 0.0 && b == 0.0) continue;
-    phi.push_back(std::atan2(b, a));
-  }
-  std::sort(phi.begin(), phi.end());
-}
-
-}  // namespace
-
 bool NormalsMeetOnOneAxis(const Vec3* points, const double* distances, const Vec3* gradients, size_t count,
                           const TangentRank& r, double max_residual) {
   // Each line m, in the plane's coordinates: a_m · c = b_m, a_m the unit normal of the line (its direction
@@ -469,10 +451,19 @@ bool SeesTwoPlanes(const Vec3* normals, size_t count, const TangentRank& r, doub
   const double root = std::sqrt(std::max(0.0, 1.0 - 4.0 * p));
   const double s1 = r.singular_values[0], s2 = r.singular_values[1];
   if (2.0 * s2 * s2 * (1.0 + root) < (1.0 - root) * s1 * s1) return false;
+  // Axis angles in (−π/2, π/2] around the dominant direction v₁: a normal and its opposite are one plane.
   thread_local std::vector<double> phi;
-  SortedAxisAngles(normals, count, r, phi);
+  phi.clear();
+  phi.reserve(count);
+  for (size_t m = 0; m < count; ++m) {
+    double a = normals[m].dot(r.v.col(0)), b = normals[m].dot(r.v.col(1));
+    if (a < 0.0) a = -a, b = -b;
+    if (a == 0.0 && b == 0.0) continue;
+    phi.push_back(std::atan2(b, a));
+  }
   const size_t n = phi.size();
   if (n < 2 * min_group) return false;
+  std::sort(phi.begin(), phi.end());
   double sum = 0.0, sum_sq = 0.0;
   for (double x : phi) sum += x, sum_sq += x * x;
   // Prefix sums give each split's within-group sum of squares in O(1).
