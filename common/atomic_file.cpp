@@ -163,6 +163,8 @@ void OutputSet::Add(const std::string& path) {
     const std::string pattern = DirectoryOf(e->target.path) + "/." + BaseName(e->target.path) + ".tmp.XXXXXX";
     std::vector<char> name(pattern.begin(), pattern.end());
     name.push_back('\0');
+    // A signal between creating the file and registering it would leave the file behind.
+    DeferCleanupSignals defer;
     e->fd = mkostemp(name.data(), O_CLOEXEC);
     if (e->fd < 0) throw OutputError(path, "cannot create a temporary file beside it: " + Errno());
     e->temp = name.data();
@@ -223,6 +225,7 @@ void OutputSet::Commit() {
     if (!e->written) throw Error("internal: output '" + e->target.given + "' was never written");
   for (const auto& e : entries_)
     if (e->target.kind == OutputKind::kStream) WriteStream(e->target, e->held);
+  DeferCleanupSignals defer;  // the renames publish the set together: a signal waits until all are done
   for (auto& e : entries_) {
     if (e->target.kind != OutputKind::kReplace) continue;
     if (rename(e->temp.c_str(), e->target.path.c_str()) != 0)

@@ -23,6 +23,8 @@ struct TempSlot {
 TempSlot g_temps[kMaxCleanupEntries];
 std::atomic<int> g_groups[kMaxCleanupEntries];  // 0 = free
 std::atomic<bool> g_installed{false};
+std::atomic<int> g_deferring{0};      // DeferCleanupSignals alive
+std::atomic<int> g_pending_signal{0};  // a signal that arrived while deferring
 
 constexpr double kSignalGrace_s = 0.5;
 
@@ -32,6 +34,9 @@ void RemoveTemporaryFiles() {
 }
 
 void OnSignal(int sig) {
+  // Recorded before the check, so that a deferral ending meanwhile still sees it.
+  g_pending_signal.store(sig);
+  if (g_deferring.load() > 0) return;
   RemoveTemporaryFiles();
   TerminateChildProcessGroups(kSignalGrace_s);
   signal(sig, SIG_DFL);
@@ -59,9 +64,17 @@ void InstallCleanupHandlers() {
   struct sigaction action;
   std::memset(&action, 0, sizeof action);
   action.sa_handler = OnSignal;
+  action.sa_flags = SA_RESTART;  // a deferred signal returns into the interrupted call
   sigemptyset(&action.sa_mask);
   for (int sig : {SIGINT, SIGTERM, SIGHUP}) sigaddset(&action.sa_mask, sig);
   for (int sig : {SIGINT, SIGTERM, SIGHUP}) sigaction(sig, &action, nullptr);
+}
+
+DeferCleanupSignals::DeferCleanupSignals() { g_deferring.fetch_add(1); }
+
+DeferCleanupSignals::~DeferCleanupSignals() {
+  if (g_deferring.fetch_sub(1) != 1) return;
+  if (const int sig = g_pending_signal.exchange(0); sig != 0) OnSignal(sig);
 }
 
 void RegisterTemporaryFile(const char* path) {

@@ -11,6 +11,17 @@ constexpr int kMaxCleanupEntries = 16;
 /// default action. Idempotent.
 void InstallCleanupHandlers();
 
+/// While one exists, a SIGINT/SIGTERM/SIGHUP is held back and acted on when the last one ends, so that a
+/// step such as "create a file, then register it" or "publish every output of a set" is never cut in the
+/// middle. A flag rather than a signal mask, because any thread of the process may receive the signal.
+class DeferCleanupSignals {
+ public:
+  DeferCleanupSignals();
+  ~DeferCleanupSignals();
+  DeferCleanupSignals(const DeferCleanupSignals&) = delete;
+  DeferCleanupSignals& operator=(const DeferCleanupSignals&) = delete;
+};
+
 /// Tracks a temporary file to remove if a signal ends the process. Throws Error if kMaxCleanupEntries are
 /// already tracked. `path` is copied.
 void RegisterTemporaryFile(const char* path);

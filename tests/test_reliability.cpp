@@ -8,12 +8,14 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdlib>
 #include <fstream>
 #include <thread>
 
 #include "common/atomic_file.h"
+#include "common/cleanup.h"
 #include "common/errors.h"
 #include "common/input_file.h"
 #include "formats/mesh_io.h"
@@ -143,6 +145,41 @@ TEST(OutputSets, AllOrNothing) {
   EXPECT_EQ(ReadBytes(dir / "a.ply"), "new a");
   EXPECT_EQ(ReadBytes(dir / "b.ply"), "new b");
   EXPECT_EQ(dir.List().size(), 2u);
+}
+
+// A signal that lands while a temporary file is being created and registered, or while a set is being
+// published, is acted on only when that step is done: here raised inside the step, from another thread as
+// the kernel may pick any thread, in a child that has the stages' handlers installed.
+TEST(OutputSets, ASignalInsideCreationOrPublicationWaitsForTheStepToFinish) {
+  for (const bool commit : {false, true}) {
+    TempDir dir;
+    const pid_t pid = fork();
+    ASSERT_GE(pid, 0);
+    if (pid == 0) {
+      InstallCleanupHandlers();
+      OutputSet set;
+      set.Add(dir / "a.ply");
+      set.Add(dir / "b.ply");
+      set.Write(dir / "a.ply", "a");
+      set.Write(dir / "b.ply", "b");
+      {
+        DeferCleanupSignals step;
+        std::thread([] { kill(getpid(), SIGTERM); }).join();
+        // Still running: the handler has returned; mark that, then end the step (the signal acts there).
+        WriteBytes(dir / "ran-on.txt", "");
+        if (commit) set.Commit();
+      }
+      _exit(0);
+    }
+    int status = 0;
+    waitpid(pid, &status, 0);
+    EXPECT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == SIGTERM) << status;
+    const std::vector<std::string> expected =
+        commit ? std::vector<std::string>{"a.ply", "b.ply", "ran-on.txt"} : std::vector<std::string>{"ran-on.txt"};
+    std::vector<std::string> names = dir.List();
+    std::sort(names.begin(), names.end());
+    EXPECT_EQ(names, expected) << (commit ? "published together" : "both temporaries removed");
+  }
 }
 
 TEST(OutputSets, TheSameFileTwiceIsAUsageErrorWhateverItsSpelling) {
