@@ -115,6 +115,41 @@ TEST(RestrictedDual, ABlockedTriangleWhoseRemovalWouldOpenAHoleStaysOrIsFlippedA
   EXPECT_EQ(stats.kept_against_holes, 0u);
 }
 
+TEST(RestrictedDual, AHoleWhoseOutlineIsOneJunctionIsFilledWithItsTriangulation) {
+  // A quadrilateral junction A B C D on the plane z = 0 whose Delaunay diagonal is AC, in a ring of outer
+  // seeds E F G H. The samples saw (A, B, C) and (A, B, D) but not (A, C, D). C blocks (A, B, D), which
+  // goes (its edge BD is free), and the hole A C D is left: its outline is the junction's seeds, and the
+  // triangle of their Delaunay triangulation that is missing fills it.
+  const std::vector<Vec3> p = {{0, 0, 0},    {1, 0, 0},    {0.9, 0.9, 0}, {0, 1, 0},
+                               {0.5, -0.8, 0}, {1.8, 0.5, 0}, {0.5, 1.8, 0}, {-0.8, 0.5, 0}};
+  enum { A, B, C, D, E, F, G, H };
+  std::vector<Tri> witnessed = {SortedTri({A, B, C}), SortedTri({A, B, D}), SortedTri({A, B, E}),
+                                SortedTri({B, C, F}), SortedTri({C, D, G}), SortedTri({D, A, H})};
+  std::sort(witnessed.begin(), witnessed.end());
+  const std::vector<Vec3> normals(p.size(), Vec3(0, 0, 1));
+  std::vector<uint8_t> on_sheet(p.size(), 1);
+  RestrictedDualStats stats;
+  const std::vector<Tri> out = LocallyDelaunayTriples(p, normals, on_sheet, witnessed, 25.0, &stats);
+  std::vector<Tri> expected = {SortedTri({A, B, C}), SortedTri({A, C, D}), SortedTri({A, B, E}),
+                               SortedTri({B, C, F}), SortedTri({C, D, G}), SortedTri({D, A, H})};
+  std::sort(expected.begin(), expected.end());
+  EXPECT_EQ(out, expected);
+  EXPECT_EQ(stats.gaps_closed, 1u);
+  const TopologyStats topo = ComputeTopology(TriangleMesh{p, out});
+  EXPECT_EQ(topo.euler, 1) << "a disc: the hole is filled";
+  EXPECT_EQ(topo.boundary_edges, 8u) << "the outline of the ring only";
+  EXPECT_EQ(topo.nonmanifold_edges, 0u);
+  // A triple in the hole (the outer seed G moved into it, D G C witnessed there): not a junction's hole.
+  std::vector<Vec3> q = p;
+  q[G] = Vec3(0.4, 0.7, 0);
+  EXPECT_EQ(LocallyDelaunayTriples(q, normals, on_sheet, witnessed, 25.0, &stats).size(), 5u);
+  EXPECT_EQ(stats.gaps_closed, 0u);
+  // Only curve seeds but one: the chain rules' business, not the chart's.
+  on_sheet = {0, 0, 0, 0, 1, 1, 1, 1};
+  LocallyDelaunayTriples(p, normals, on_sheet, witnessed, 25.0, &stats);
+  EXPECT_EQ(stats.gaps_closed, 0u);
+}
+
 // Two curve seeds 0, 1 on the line where the planes z = 0 and x = 0 cross, and a sheet seed on each of the
 // four half-planes around it, each moved by up to `jitter` (a chain with a gap: the six regions nearly meet
 // at one point, so the dense samples witness nearly every triple); then the chain's next seeds on either

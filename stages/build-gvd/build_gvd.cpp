@@ -598,8 +598,8 @@ std::vector<Tri> DualTriangles(const Graph& graph, const std::vector<int>& label
     for (size_t i = 0; i < num_seeds; ++i) on_sheet[i] = on_sheet[i] && seeds.rank[i] <= kRankSheet;
     faces = LocallyDelaunayTriples(seeds.position, seed_normal, on_sheet, faces, options.chart_angle_deg, &rd);
     monitor.Info(Format("locally Delaunay: %zu triples of %zu witnessed (%zu collinear; of those whose removal would open "
-                        "a hole, %zu kept and %zu jumping a feature seed flipped, %zu triangles new)",
-                        rd.kept, rd.witnessed, rd.degenerate, rd.kept_against_holes, rd.replaced, rd.added));
+                        "a hole, %zu kept and %zu jumping a feature seed flipped; %zu holes at a junction filled; %zu triangles new)",
+                        rd.kept, rd.witnessed, rd.degenerate, rd.kept_against_holes, rd.replaced, rd.gaps_closed, rd.added));
     if (options.chain_links) {
       std::vector<uint8_t> is_curve(num_seeds);
       for (size_t i = 0; i < num_seeds; ++i) is_curve[i] = IsCurveSeed(seeds, i);

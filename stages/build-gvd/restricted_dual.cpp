@@ -339,6 +339,90 @@ size_t SpanJunctionsByTheirLinks(const std::vector<Vec3>& seeds, const Chain& ch
   return spanned;
 }
 
+// A triple the chart blocks, with its blocker and their chart: four seeds of one junction.
+struct BlockedTriple {
+  Tri t;
+  int v;
+  Vec3 chart;
+};
+
+// Where the samples saw a junction of four regions only in part, a hole is left whose outline is the four
+// seeds: a blocked triple (p, q, r) the guard removed, its blocker v beyond pq (a convex quadrilateral), and
+// no triple in it but the one triangle of their Delaunay triangulation the samples may have seen. It is
+// filled with that triangulation in the chart, the flip (p, r, v), (r, v, q). The outline's edges must carry
+// triples, all outside the quadrilateral in the chart (one each, or several where both ends are curve seeds:
+// a link where sheets meet), and the diagonals no other, so the fill adds no fold and no branching edge on a
+// sheet and closes exactly that hole. At least two of the four must be sheet seeds: among curve seeds alone
+// the chain rules decide. Returns how many holes were filled, counts the triangles added in `*added` and
+// updates `triples`.
+size_t CloseJunctionGaps(const std::vector<Vec3>& seeds, const std::vector<uint8_t>& on_sheet,
+                         const std::vector<BlockedTriple>& junctions, std::vector<Tri>& triples, size_t* added) {
+  auto key = [](int a, int b) {
+    return (static_cast<uint64_t>(std::min(a, b)) << 32) | static_cast<uint32_t>(std::max(a, b));
+  };
+  std::unordered_map<uint64_t, std::vector<int>> thirds;  // edge -> the third seeds of its triples
+  std::unordered_set<Tri, TriHash> present(triples.begin(), triples.end());
+  auto add = [&](const Tri& t) {
+    for (int k = 0; k < 3; ++k) thirds[key(t[k], t[(k + 1) % 3])].push_back(t[(k + 2) % 3]);
+  };
+  for (const Tri& t : triples) add(t);
+  size_t closed = 0;
+  for (const auto& [t, v, chart] : junctions) {
+    const std::vector<Tri> flip = DelaunayReplacement(t, v, chart, seeds);
+    if (flip.size() != 2) continue;
+    int sheets = on_sheet[static_cast<size_t>(v)];
+    for (int x : t) sheets += on_sheet[static_cast<size_t>(x)];
+    if (sheets < 2) continue;
+    int ends[2], n = 0, r = -1;  // p, q: in one triangle of the flip each; r: in both
+    for (int x : t) {
+      const auto in = std::count_if(flip.begin(), flip.end(),
+                                    [&](const Tri& f) { return std::find(f.begin(), f.end(), x) != f.end(); });
+      if (in == 1 && n < 2) ends[n++] = x;
+      if (in == 2) r = x;
+    }
+    if (n != 2 || r < 0) continue;
+    const int p = ends[0], q = ends[1];
+    // A convex quadrilateral: v beyond pq only, so the flip's two triangles do not overlap.
+    auto at = [&](int i) -> const Vec3& { return seeds[static_cast<size_t>(i)]; };
+    auto same_side = [&](int a, int b, int x, int y) {
+      const Vec3 across = chart.cross(at(b) - at(a));
+      return across.dot(at(x) - at(a)) * across.dot(at(y) - at(a)) > 0;
+    };
+    if (!same_side(r, p, v, q) || !same_side(r, q, v, p)) continue;
+    // The guard leaves no blocked triple with a free edge, so a hole beside one is the whole quadrilateral.
+    if (present.count(t)) continue;
+    auto part_of_fill = [&](const Tri& f) { return f == flip[0] || f == flip[1]; };
+    // No other triple on a diagonal; on an edge ab of the outline none inside (towards c and d) in the chart,
+    // and outside one, or several where a and b are curve seeds (a link where sheets meet).
+    auto clear = [&](int a, int b, bool diagonal, int c, int d) {
+      const Vec3 across = chart.cross(at(b) - at(a)).normalized();
+      const double inside = across.dot(at(c) - at(a)) + across.dot(at(d) - at(a));
+      int outside = 0;
+      for (int w : thirds[key(a, b)]) {
+        if (part_of_fill(SortedTri({a, b, w}))) continue;
+        const Vec3 dw = at(w) - at(a);
+        const bool in_chart = std::abs(chart.dot(dw)) < std::abs(across.dot(dw));
+        if (diagonal || (in_chart && across.dot(dw) * inside > 0)) return false;
+        ++outside;
+      }
+      const bool link = !on_sheet[static_cast<size_t>(a)] && !on_sheet[static_cast<size_t>(b)];
+      return diagonal || outside == 1 || (outside > 1 && link);
+    };
+    if (!clear(p, q, true, r, v) || !clear(r, v, true, p, q) || !clear(v, p, false, q, r) || !clear(v, q, false, p, r) ||
+        !clear(r, p, false, q, v) || !clear(r, q, false, p, v))
+      continue;
+    if (present.count(flip[0]) && present.count(flip[1])) continue;  // nothing missing
+    for (const Tri& f : flip)
+      if (present.insert(f).second) {
+        add(f);
+        ++*added;
+      }
+    ++closed;
+  }
+  triples.assign(present.begin(), present.end());
+  return closed;
+}
+
 }  // namespace
 
 std::vector<Tri> KeepChainLinks(const std::vector<Vec3>& seeds, const std::vector<uint8_t>& is_curve,
@@ -413,6 +497,7 @@ std::vector<Tri> LocallyDelaunayTriples(const std::vector<Vec3>& seeds, const st
   // unless it jumps a feature seed along a chain, where its Delaunay flip through that seed replaces it.
   auto blocked = [&](size_t f) { return blocker[f].first >= 0; };
   FaceComplex complex(candidates);
+  auto flip_of = [&](size_t f) { return DelaunayReplacement(candidates[f], blocker[f].first, blocker[f].second, seeds); };
   for (bool removed = true; removed;) {
     removed = false;
     for (size_t f = 0; f < candidates.size(); ++f) {
@@ -434,7 +519,7 @@ std::vector<Tri> LocallyDelaunayTriples(const std::vector<Vec3>& seeds, const st
     if (!blocked(f) || !complex.present(static_cast<int>(f))) continue;
     const Tri& t = candidates[f];
     const int v = blocker[f].first;
-    const std::vector<Tri> flip = DelaunayReplacement(t, v, blocker[f].second, seeds);
+    const std::vector<Tri> flip = flip_of(f);
     // A jump: the blocker is a feature seed beyond (or on) an edge of two feature seeds, so the triangle spans
     // it along a chain. The two vertices of that edge are each in one triangle of the flip.
     bool jump = flip.size() == 2 && !on_sheet[static_cast<size_t>(v)];
@@ -456,6 +541,10 @@ std::vector<Tri> LocallyDelaunayTriples(const std::vector<Vec3>& seeds, const st
         ++stats.added;
       }
   }
+  std::vector<BlockedTriple> junctions;
+  for (size_t f = 0; f < candidates.size(); ++f)
+    if (blocked(f)) junctions.push_back({candidates[f], blocker[f].first, blocker[f].second});
+  stats.gaps_closed = CloseJunctionGaps(seeds, on_sheet, junctions, kept, &stats.added);
   std::sort(kept.begin(), kept.end());
   stats.kept = kept.size();
   if (stats_out) *stats_out = stats;

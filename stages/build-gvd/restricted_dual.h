@@ -15,7 +15,8 @@ struct RestrictedDualStats {
   size_t degenerate = 0;    ///< of those, collinear seeds (no circumsphere): dropped
   size_t kept_against_holes = 0;  ///< blocked triples kept: removing them would open a hole (hole guard)
   size_t replaced = 0;      ///< blocked triples that would open a hole and jump a feature seed: flipped
-  size_t added = 0;         ///< triangles those flips added (not witnessed)
+  size_t gaps_closed = 0;   ///< holes whose outline is one junction's four seeds, filled (CloseJunctionGaps)
+  size_t added = 0;         ///< triangles the flips and fills added (not witnessed)
 };
 
 /// The locally Delaunay witnessed triples. A witnessed triple (i, j, k) — three seeds whose geodesic
@@ -44,6 +45,14 @@ struct RestrictedDualStats {
 /// of two feature seeds (the triangle jumps it along a chain): then the Delaunay flip through that seed, in
 /// their chart, takes its place. **Invariant:** the filter lowers b2 and never raises b1 over the witnessed
 /// triples, except through the flips, which cover the same part of the chart.
+///
+/// Junction holes: where the samples saw a junction of four regions only in part, the hole left has the four
+/// seeds as its outline — a blocked triple, its blocker beyond one of its edges, and nothing in the
+/// quadrilateral but what the samples saw of it. The missing triangles of the four seeds' Delaunay
+/// triangulation in their chart fill it (the blocked triple, if still there, gives way to them). Each edge of
+/// the outline must carry a triple outside the quadrilateral (one, or several at a link of two curve seeds),
+/// no other triple may lie in it, and two of the four at least must be sheet seeds. **Invariant:** a fill
+/// closes exactly one hole (b1 falls by one) and adds no fold or branching edge on a sheet.
 ///
 /// \param seeds      seed positions
 /// \param normals    a unit surface normal (UDF gradient) per seed, either orientation; zero: no chart
