@@ -353,19 +353,13 @@ struct BlockedTriple {
 // triples, all outside the quadrilateral in the chart (one each, or several where both ends are curve seeds:
 // a link where sheets meet), and the diagonals no other, so the fill adds no fold and no branching edge on a
 // sheet and closes exactly that hole. At least two of the four must be sheet seeds: among curve seeds alone
-// the chain rules decide. Returns how many holes were filled, counts the triangles added in `*added` and
-// updates `triples`.
+// the chain rules decide. `neighbours`: the geodesic neighbours of the witnessed triples (every pair of a
+// flip is one). Returns how many holes were filled, counts the triangles added in `*added` and updates
+// `triples`.
 size_t CloseJunctionGaps(const std::vector<Vec3>& seeds, const std::vector<uint8_t>& on_sheet,
-                         const std::vector<BlockedTriple>& junctions, std::vector<Tri>& triples, size_t* added) {
-  auto key = [](int a, int b) {
-    return (static_cast<uint64_t>(std::min(a, b)) << 32) | static_cast<uint32_t>(std::max(a, b));
-  };
-  std::unordered_map<uint64_t, std::vector<int>> thirds;  // edge -> the third seeds of its triples
-  std::unordered_set<Tri, TriHash> present(triples.begin(), triples.end());
-  auto add = [&](const Tri& t) {
-    for (int k = 0; k < 3; ++k) thirds[key(t[k], t[(k + 1) % 3])].push_back(t[(k + 2) % 3]);
-  };
-  for (const Tri& t : triples) add(t);
+                         const std::vector<std::vector<int>>& neighbours, const std::vector<BlockedTriple>& junctions,
+                         std::vector<Tri>& triples, size_t* added) {
+  LiveTriples live(triples);
   size_t closed = 0;
   for (const auto& [t, v, chart] : junctions) {
     const std::vector<Tri> flip = DelaunayReplacement(t, v, chart, seeds);
@@ -390,7 +384,7 @@ size_t CloseJunctionGaps(const std::vector<Vec3>& seeds, const std::vector<uint8
     };
     if (!same_side(r, p, v, q) || !same_side(r, q, v, p)) continue;
     // The guard leaves no blocked triple with a free edge, so a hole beside one is the whole quadrilateral.
-    if (present.count(t)) continue;
+    if (live.Has(t[0], t[1], t[2])) continue;
     auto part_of_fill = [&](const Tri& f) { return f == flip[0] || f == flip[1]; };
     // No other triple on a diagonal; on an edge ab of the outline none inside (towards c and d) in the chart,
     // and outside one, or several where a and b are curve seeds (a link where sheets meet).
@@ -398,7 +392,7 @@ size_t CloseJunctionGaps(const std::vector<Vec3>& seeds, const std::vector<uint8
       const Vec3 across = chart.cross(at(b) - at(a)).normalized();
       const double inside = across.dot(at(c) - at(a)) + across.dot(at(d) - at(a));
       int outside = 0;
-      for (int w : thirds[key(a, b)]) {
+      for (int w : live.Thirds(a, b, neighbours)) {
         if (part_of_fill(SortedTri({a, b, w}))) continue;
         const Vec3 dw = at(w) - at(a);
         const bool in_chart = std::abs(chart.dot(dw)) < std::abs(across.dot(dw));
@@ -411,15 +405,12 @@ size_t CloseJunctionGaps(const std::vector<Vec3>& seeds, const std::vector<uint8
     if (!clear(p, q, true, r, v) || !clear(r, v, true, p, q) || !clear(v, p, false, q, r) || !clear(v, q, false, p, r) ||
         !clear(r, p, false, q, v) || !clear(r, q, false, p, v))
       continue;
-    if (present.count(flip[0]) && present.count(flip[1])) continue;  // nothing missing
-    for (const Tri& f : flip)
-      if (present.insert(f).second) {
-        add(f);
-        ++*added;
-      }
+    if (live.present.count(flip[0]) && live.present.count(flip[1])) continue;  // nothing missing
+    live.ReplaceUnlessItOpens({}, flip);  // adds only: opens nothing
     ++closed;
   }
-  triples.assign(present.begin(), present.end());
+  *added += live.added.size();
+  triples.assign(live.present.begin(), live.present.end());
   return closed;
 }
 
@@ -497,7 +488,6 @@ std::vector<Tri> LocallyDelaunayTriples(const std::vector<Vec3>& seeds, const st
   // unless it jumps a feature seed along a chain, where its Delaunay flip through that seed replaces it.
   auto blocked = [&](size_t f) { return blocker[f].first >= 0; };
   FaceComplex complex(candidates);
-  auto flip_of = [&](size_t f) { return DelaunayReplacement(candidates[f], blocker[f].first, blocker[f].second, seeds); };
   for (bool removed = true; removed;) {
     removed = false;
     for (size_t f = 0; f < candidates.size(); ++f) {
@@ -519,7 +509,7 @@ std::vector<Tri> LocallyDelaunayTriples(const std::vector<Vec3>& seeds, const st
     if (!blocked(f) || !complex.present(static_cast<int>(f))) continue;
     const Tri& t = candidates[f];
     const int v = blocker[f].first;
-    const std::vector<Tri> flip = flip_of(f);
+    const std::vector<Tri> flip = DelaunayReplacement(t, v, blocker[f].second, seeds);
     // A jump: the blocker is a feature seed beyond (or on) an edge of two feature seeds, so the triangle spans
     // it along a chain. The two vertices of that edge are each in one triangle of the flip.
     bool jump = flip.size() == 2 && !on_sheet[static_cast<size_t>(v)];
@@ -544,7 +534,7 @@ std::vector<Tri> LocallyDelaunayTriples(const std::vector<Vec3>& seeds, const st
   std::vector<BlockedTriple> junctions;
   for (size_t f = 0; f < candidates.size(); ++f)
     if (blocked(f)) junctions.push_back({candidates[f], blocker[f].first, blocker[f].second});
-  stats.gaps_closed = CloseJunctionGaps(seeds, on_sheet, junctions, kept, &stats.added);
+  stats.gaps_closed = CloseJunctionGaps(seeds, on_sheet, neighbours, junctions, kept, &stats.added);
   std::sort(kept.begin(), kept.end());
   stats.kept = kept.size();
   if (stats_out) *stats_out = stats;

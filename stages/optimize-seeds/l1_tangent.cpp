@@ -404,6 +404,7 @@ bool NormalsMeetOnOneAxis(const Vec3* points, const double* distances, const Vec
   // Each line m, in the plane's coordinates: a_m · c = b_m, a_m the unit normal of the line (its direction
   // turned by 90°), b_m = a_m · f_m, f_m the foot point. Least squares for c: (Σ a aᵀ) c = Σ a b.
   thread_local std::vector<Eigen::Vector2d> foot, across;
+  thread_local std::vector<double> radius;
   foot.clear(), across.clear();
   const Vec3 e1 = r.v.col(0), e2 = r.v.col(1);
   for (size_t m = 0; m < count; ++m) {
@@ -428,7 +429,7 @@ bool NormalsMeetOnOneAxis(const Vec3* points, const double* distances, const Vec
   if (eig.eigenvalues()(0) < 1e-3 * static_cast<double>(n)) return false;
   const Eigen::Vector2d c = ata.ldlt().solve(atb);
   double residual2 = 0.0, spread2 = 0.0;
-  std::vector<double> radius(n);
+  radius.resize(n);
   for (size_t m = 0; m < n; ++m) {
     residual2 += std::pow(across[m].dot(c) - across[m].dot(foot[m]), 2);
     spread2 += (foot[m] - mean).squaredNorm();
