@@ -294,7 +294,8 @@ TEST_F(ChainTest, FoldKeepsItsShallowCreaseAsAChainOfEdges) {
 // (non-manifold and boundary edges: the thin-feature limit, docs/thin-mesh.md "Known limits"). How much of
 // the spike's edge is traced depends on the draw: over sample-seeds --seed 1-8, 0.19-0.90 (mean 0.63; this
 // test's --seed 1 gives the least, where thin-mesh's small-component step removes the strips beside the
-// edge); with the paper's curve step and no chain filling, 0.24-0.98 (mean 0.58).
+// edge); with the paper's curve step and no chain filling, 0.24-0.98 (mean 0.58). So does the share of the
+// concave corner's edges towards the spike: over --seed 1-6, 0.87-0.97 (0.83-0.98 with three pool layers).
 TEST_F(ChainTest, FeaturePrismTracesItsConcaveShortAndNarrowEdges) {
   if (!HaveOptimizer()) GTEST_SKIP() << "optimize-seeds is not built";
   const Chain c = RunChain(dir_, "feature-prism", 2500, 0.0, true);
@@ -334,7 +335,8 @@ TEST_F(ChainTest, FeaturePrismTracesItsConcaveShortAndNarrowEdges) {
     if (i != spike) {
       EXPECT_GE(vertical, 0.95) << "vertical edge " << i;
     }
-    EXPECT_GE(std::min(bottom, top), i == chamfer || i + 1 >= spike ? 0.9 : 0.95) << "edges " << i << "-" << j;
+    EXPECT_GE(std::min(bottom, top), i + 1 == spike ? 0.85 : i == chamfer || i + 1 > spike ? 0.9 : 0.95)
+        << "edges " << i << "-" << j;
   }
   EXPECT_GE(traced(concave, n + concave), 0.95) << "the concave edge";
   EXPECT_GE(traced(spike, n + spike), 0.15) << "the spike's edge";

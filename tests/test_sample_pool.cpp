@@ -157,7 +157,7 @@ TEST(SamplePool, OptimizeSeedsAsksAFractionOfTheQueriesForSeedsAsGood) {
   so.count = 600;
   so.seed = 2;
   const SeedCloud in = SampleSeeds(*cube, so, Monitor::Null());
-  auto run = [&](const std::string& mode, uint64_t* queries, int layers = 3) {
+  auto run = [&](const std::string& mode, uint64_t* queries, int layers = OptimizeSeedsOptions().pool_layers) {
     auto usage = std::make_shared<UdfUsage>();
     const CountingUdf udf(MakeShape("cube"), usage);
     OptimizeSeedsOptions o;
@@ -169,8 +169,9 @@ TEST(SamplePool, OptimizeSeedsAsksAFractionOfTheQueriesForSeedsAsGood) {
   };
   uint64_t fresh_q = 0, pool_q = 0, one_layer_q = 0;
   const SeedCloud fresh = run("fresh", &fresh_q), pooled = run("pool", &pool_q), one_layer = run("pool", &one_layer_q, 1);
-  // Three layers: each round's samples are new only where the cell changed or its layer was not asked yet
-  // (0.38 of fresh's here: both keep the cells nothing changed, so fresh pays only for the changed ones).
+  // The default layers: each round's samples are new only where the cell changed or its layer was not asked
+  // yet (0.38 of fresh's here with three layers: both keep the cells nothing changed, so fresh pays only for
+  // the changed ones).
   EXPECT_LT(pool_q, fresh_q * 9 / 20) << "pool " << pool_q << " vs fresh " << fresh_q << " queries";
   EXPECT_LT(one_layer_q, fresh_q / 6) << "one layer " << one_layer_q << " vs fresh " << fresh_q << " queries";
   EXPECT_LT(one_layer_q, pool_q);

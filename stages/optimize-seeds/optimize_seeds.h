@@ -26,7 +26,8 @@ struct OptimizeSeedsOptions {
   std::string cell_samples = "pool";
   /// --pool-layers: the pool is split into this many independent point sets, which the sampling rounds
   /// take in turn, so that consecutive rounds see independent samples of a cell (1: every round the same).
-  int pool_layers = 3;
+  /// Each layer costs about M UDF queries per seed (docs/optimize-seeds.md, "Sample pool").
+  int pool_layers = 2;
   /// --repulsion-cells: "every", every repulsion round draws the cells again for the ranks and move spaces
   /// (the paper's loop); "first", only the first round of an outer iteration does, and the later rounds keep
   /// those ranks, a sheet seed moving in the tangent plane of its own gradient. Not in the paper, see
