@@ -384,7 +384,7 @@ size_t CloseJunctionGaps(const std::vector<Vec3>& seeds, const std::vector<uint8
     };
     if (!same_side(r, p, v, q) || !same_side(r, q, v, p)) continue;
     // The guard leaves no blocked triple with a free edge, so a hole beside one is the whole quadrilateral.
-    if (live.Has(t[0], t[1], t[2])) continue;
+    if (live.present.count(t)) continue;
     auto part_of_fill = [&](const Tri& f) { return f == flip[0] || f == flip[1]; };
     // No other triple on a diagonal; on an edge ab of the outline none inside (towards c and d) in the chart,
     // and outside one, or several where a and b are curve seeds (a link where sheets meet).
