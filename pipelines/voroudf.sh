@@ -10,6 +10,7 @@
 #   --STAGE "ARGS"  extra options for that stage (split on spaces), e.g. --optimize-seeds "--gamma 5"
 #   --fast          0.55-0.65x the time and UDF queries, rougher meshes: optimize-seeds gets
 #                   --samples-per-cell 60 --repulsion-cells first, build-gvd --samples-per-seed 100
+#                   --curve-sample-weight 1
 #                   (docs/performance.md, "A faster chain"); those options cannot be given again
 #   --from STAGE    start at this stage (optimize-seeds, build-gvd or thin-mesh), with the earlier stages'
 #                   files already in DIR: to try one stage's options or program on the same input
@@ -51,7 +52,7 @@ done
 # The fast setting: fewer samples per cell, the cells drawn once per outer iteration, a sparser graph.
 if [ "$FAST" = 1 ]; then
   A_OPT="--samples-per-cell 60 --repulsion-cells first $A_OPT"
-  A_GVD="--samples-per-seed 100 $A_GVD"
+  A_GVD="--samples-per-seed 100 --curve-sample-weight 1 $A_GVD"
 fi
 # The stages in order, and the file each reads from DIR.
 STAGES=(sample-seeds optimize-seeds build-gvd thin-mesh)

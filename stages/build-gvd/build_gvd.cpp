@@ -72,6 +72,8 @@ void BuildGvdOptions::Check() const {
   if (!(eps_grad_wall > 0.0 && eps_grad_wall <= 1.0)) throw UsageError("--eps-grad-wall must be in (0, 1]");
   if (curve_samples != "tangent" && curve_samples != "ball") throw UsageError("--curve-samples must be tangent or ball");
   if (ball_shares != "area" && ball_shares != "seed") throw UsageError("--ball-shares must be area or seed");
+  if (!(curve_sample_weight > 0.0 && curve_sample_weight <= 100.0))
+    throw UsageError("--curve-sample-weight must be in (0, 100]");
   CheckRelativeProjection(proj_tol_rel, proj_floor_rel, proj_max_iters, proj_twin_factor);
 }
 
@@ -109,16 +111,25 @@ std::vector<Vec3> DrawSamples(const SeedCloud& seeds, const Box& box, const Buil
     radius[i] = std::min(0.1 * diag, options.ball_scale * (seeds.position[static_cast<size_t>(far)] - seeds.position[i]).norm());
     if (!(radius[i] > 0.0)) radius[i] = 1e-4 * diag;  // coincident seeds
   }
-  const size_t total = static_cast<size_t>(std::llround(options.samples_per_seed * static_cast<double>(num_seeds)));
-  const size_t in_space = static_cast<size_t>(std::llround(options.space_fraction * static_cast<double>(total)));
+  // A curve or corner seed's ball gets curve_sample_weight times a sheet seed's samples: its region is
+  // narrow (curve seeds are spaced along their curve, not by the sheet) and holds the Voronoi vertices where
+  // sheets meet, which a sheet seed's share at the sheets' density leaves unseen (docs/build-gvd.md).
+  double ball_weight_sum = 0.0;
+  for (size_t s = 0; s < num_seeds; ++s) ball_weight_sum += IsCurveSeed(seeds, s) ? options.curve_sample_weight : 1.0;
+  const size_t unweighted = static_cast<size_t>(std::llround(options.samples_per_seed * static_cast<double>(num_seeds)));
+  const size_t in_space = static_cast<size_t>(std::llround(options.space_fraction * static_cast<double>(unweighted)));
+  const size_t total = in_space + static_cast<size_t>(std::llround(static_cast<double>(unweighted - in_space) *
+                                                                   ball_weight_sum / static_cast<double>(num_seeds)));
   // Each seed's ball gets samples in proportion to radius^2, the area its ball covers on a sheet, so the
   // sample density on the surface is even where the seeds are not (e.g. before optimisation, or on a torus'
   // saddle, where uniform draws are sparse); with --ball-shares seed, as many per seed, so that seeds packed
   // closer on purpose keep their regions' samples. ball_end[s] is one past seed s's last ball sample.
   std::vector<size_t> ball_end(num_seeds);
   {
-    const bool per_seed = options.ball_shares == "seed";
-    auto weight = [&](size_t s) { return per_seed ? 1.0 : radius[s] * radius[s]; };
+    const bool by_seed = options.ball_shares == "seed";
+    auto weight = [&](size_t s) {
+      return (by_seed ? 1.0 : radius[s] * radius[s]) * (IsCurveSeed(seeds, s) ? options.curve_sample_weight : 1.0);
+    };
     double weight_total = 0.0;
     for (size_t s = 0; s < num_seeds; ++s) weight_total += weight(s);
     double prefix = 0.0;

@@ -17,11 +17,14 @@
 namespace voroudf {
 
 struct BuildGvdOptions {
-  /// Dense samples drawn per seed before projection (--samples-per-seed). The kNN graph spans about
-  /// sqrt(knn / samples_per_seed) seed spacings, and the wider it is, the more spurious 4-label junctions
-  /// (flat tetrahedra for thin-mesh) appear; 200 keeps it near a third of a spacing (docs/build-gvd.md,
-  /// "Why these defaults").
-  double samples_per_seed = 200.0;
+  /// Dense samples drawn per sheet seed before projection (--samples-per-seed): space_fraction of them in the
+  /// box, the rest in its ball; a curve or corner seed's ball gets curve_sample_weight times as many. Where
+  /// the samples are too sparse for the regions, junctions go unseen (holes, boundary edges); the regions of
+  /// curve seeds are the narrowest (docs/build-gvd.md, "Why these defaults").
+  double samples_per_seed = 100.0;
+  /// Ball samples of a seed of rank 2 or 3 in the seeds file, as a multiple of a sheet seed's with the same
+  /// ball radius (--curve-sample-weight; 1: shares by the ball alone).
+  double curve_sample_weight = 3.0;
   /// Fraction of the dense samples drawn uniformly in the domain box (--space-fraction); the rest are drawn
   /// in balls around the seeds. Box samples project preferentially onto sharp edges, corners and open
   /// boundaries (whole wedges of space project onto them), which is where the graph must connect sheets;
@@ -107,9 +110,10 @@ struct GvdResult {
 /// Builds the approximate geodesic Voronoi diagram of `seeds` on the zero set of `udf` and its dual
 /// triangles (paper Sec. 3.3).
 ///
-///  1. samples_per_seed * N points: a space_fraction of them uniform in udf.Domain(), the rest uniform in a
+///  1. space_fraction * samples_per_seed * N points uniform in udf.Domain(), and (1 - space_fraction) *
+///     samples_per_seed per sheet seed, curve_sample_weight times that per curve or corner seed, uniform in a
 ///     ball around each seed (radius: ball_scale x distance to its 6th-nearest seed; samples per ball in
-///     proportion to radius^2, so that the density on the surface is even); each projected with x <- x - d n (common/projection.h); unconverged ones dropped.
+///     proportion to radius^2 x that weight, so that the density on the surface is even but for the weight); each projected with x <- x - d n (common/projection.h); unconverged ones dropped.
 ///     Point i draws from the counter-based stream (seed, i), so the draw does not depend on the threads.
 ///     With curve_samples "tangent", the ball samples of rank-2 and rank-3 seeds are then drawn again in a
 ///     disc of the ball's radius in the tangent plane where they landed and projected again; a redraw that

@@ -21,7 +21,9 @@ int main(int argc, char** argv) {
   cli.AddAscii(&ascii);
   auto& app = cli.app();
   app.add_flag("--graph", graph, "with --labels: also write the pruned kNN graph as an edge element");
-  app.add_option("--samples-per-seed", options.samples_per_seed, "dense samples drawn per seed");
+  app.add_option("--samples-per-seed", options.samples_per_seed, "dense samples drawn per sheet seed");
+  app.add_option("--curve-sample-weight", options.curve_sample_weight,
+                 "ball samples of a curve or corner seed (rank 2, 3) / a sheet seed's of the same ball radius");
   app.add_option("--space-fraction", options.space_fraction, "fraction of dense samples drawn in the whole box");
   app.add_option("--curve-samples", options.curve_samples,
                  "tangent: curve and corner seeds' ball samples drawn again in the tangent plane where they landed "
