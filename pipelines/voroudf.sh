@@ -8,7 +8,7 @@
 #            [--sample-seeds "ARGS"] [--optimize-seeds "ARGS"] [--build-gvd "ARGS"] [--thin-mesh "ARGS"]
 #            [--evaluate "ARGS"] [--from STAGE] [--fast]
 #   --STAGE "ARGS"  extra options for that stage (split on spaces), e.g. --optimize-seeds "--gamma 5"
-#   --fast          0.55-0.65x the time and UDF queries, rougher meshes: optimize-seeds gets
+#   --fast          0.65-0.7x the time and UDF queries, rougher meshes: optimize-seeds gets
 #                   --samples-per-cell 60 --repulsion-cells first, build-gvd --samples-per-seed 100
 #                   --curve-sample-weight 1
 #                   (docs/performance.md, "A faster chain"); those options cannot be given again
