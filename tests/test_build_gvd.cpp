@@ -564,6 +564,46 @@ TEST(BuildGvd, BallSharesBySeedKeepTheSamplesPerRegionWhereSeedsAreDense) {
   EXPECT_GT(per_seed, 0.6);
 }
 
+// --curve-sample-weight: a curve seed's ball gets W times a sheet seed's samples of the same radius. On the
+// sphere, with the seeds of the upper half marked as curve seeds (rank 2) and even spacing, the regions of the
+// upper half then hold f + (1 - f) W times the samples they hold at W = 1 (against the lower half's, away from
+// the equator), f the box share, and the draw counts exactly the weighted total.
+TEST(BuildGvd, CurveSeedsGetTheirWeightOfTheBallSamples) {
+  const auto udf = MakeShape("sphere");
+  SeedCloud seeds = Seeds(*udf, 300);
+  size_t curve = 0;
+  for (size_t i = 0; i < seeds.size(); ++i) {
+    seeds.rank[i] = seeds.position[i].z() > 0.0 ? 2 : 1;
+    curve += seeds.rank[i] == 2 ? 1 : 0;
+  }
+  auto ratio = [&](double weight) {  // mean samples per upper region / per lower region
+    BuildGvdOptions o;
+    o.curve_sample_weight = weight;
+    const GvdResult r = BuildGvd(*udf, seeds, o, false, Monitor::Null());
+    const double n = static_cast<double>(seeds.size()), unweighted = o.samples_per_seed * n;
+    const double box = std::round(o.space_fraction * unweighted);
+    const double expected = box + std::round((unweighted - box) * (n + (weight - 1.0) * static_cast<double>(curve)) / n);
+    EXPECT_EQ(static_cast<double>(r.stats.samples_drawn), expected) << "weight " << weight;
+    // Regions more than a ball's radius (about two spacings) from the equator: balls overlap their neighbours'.
+    auto far = [&](size_t s) { return std::abs(seeds.position[s].z()) > 0.25; };
+    double upper = 0, lower = 0, upper_seeds = 0, lower_seeds = 0;
+    for (size_t s = 0; s < seeds.size(); ++s)
+      if (far(s)) (seeds.rank[s] == 2 ? upper_seeds : lower_seeds) += 1;
+    for (size_t i = 0; i < r.samples.size(); ++i) {
+      if (r.samples.label[i] < 0) continue;
+      const size_t s = static_cast<size_t>(r.samples.label[i]);
+      if (far(s)) (seeds.rank[s] == 2 ? upper : lower) += 1;
+    }
+    return (upper / upper_seeds) / (lower / lower_seeds);
+  };
+  const double even = ratio(1.0), tripled = ratio(3.0);
+  std::printf("samples per upper region / per lower region: %.2f at weight 1, %.2f at weight 3\n", even, tripled);
+  // At weight 1 the curve seeds' tangent redraws spread a little wider than ball points (0.9); the weight
+  // multiplies what each region gets by f + (1 - f) W = 2.5.
+  EXPECT_NEAR(even, 1.0, 0.2);
+  EXPECT_NEAR(tripled / even, 0.25 + 0.75 * 3.0, 0.3);
+}
+
 TEST(BuildGvd, BadOptionsAndEmptySeedsAreRefused) {
   BuildGvdOptions o;
   o.knn = 1;
@@ -579,6 +619,9 @@ TEST(BuildGvd, BadOptionsAndEmptySeedsAreRefused) {
   EXPECT_THROW(o.Check(), UsageError);
   o = BuildGvdOptions{};
   o.ball_shares = "volume";
+  EXPECT_THROW(o.Check(), UsageError);
+  o = BuildGvdOptions{};
+  o.curve_sample_weight = 0;
   EXPECT_THROW(o.Check(), UsageError);
   const auto udf = MakeShape("sphere");
   EXPECT_THROW(BuildGvd(*udf, SeedCloud{}, BuildGvdOptions{}, false, Monitor::Null()), InputError);
