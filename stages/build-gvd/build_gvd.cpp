@@ -114,8 +114,9 @@ std::vector<Vec3> DrawSamples(const SeedCloud& seeds, const Box& box, const Buil
   // A curve or corner seed's ball gets curve_sample_weight times a sheet seed's samples: its region is
   // narrow (curve seeds are spaced along their curve, not by the sheet) and holds the Voronoi vertices where
   // sheets meet, which a sheet seed's share at the sheets' density leaves unseen (docs/build-gvd.md).
+  const auto rank_weight = [&](size_t s) { return IsCurveSeed(seeds, s) ? options.curve_sample_weight : 1.0; };
   double ball_weight_sum = 0.0;
-  for (size_t s = 0; s < num_seeds; ++s) ball_weight_sum += IsCurveSeed(seeds, s) ? options.curve_sample_weight : 1.0;
+  for (size_t s = 0; s < num_seeds; ++s) ball_weight_sum += rank_weight(s);
   const size_t unweighted = static_cast<size_t>(std::llround(options.samples_per_seed * static_cast<double>(num_seeds)));
   const size_t in_space = static_cast<size_t>(std::llround(options.space_fraction * static_cast<double>(unweighted)));
   const size_t total = in_space + static_cast<size_t>(std::llround(static_cast<double>(unweighted - in_space) *
@@ -127,9 +128,7 @@ std::vector<Vec3> DrawSamples(const SeedCloud& seeds, const Box& box, const Buil
   std::vector<size_t> ball_end(num_seeds);
   {
     const bool by_seed = options.ball_shares == "seed";
-    auto weight = [&](size_t s) {
-      return (by_seed ? 1.0 : radius[s] * radius[s]) * (IsCurveSeed(seeds, s) ? options.curve_sample_weight : 1.0);
-    };
+    auto weight = [&](size_t s) { return (by_seed ? 1.0 : radius[s] * radius[s]) * rank_weight(s); };
     double weight_total = 0.0;
     for (size_t s = 0; s < num_seeds; ++s) weight_total += weight(s);
     double prefix = 0.0;
