@@ -289,13 +289,13 @@ TEST_F(ChainTest, FoldKeepsItsShallowCreaseAsAChainOfEdges) {
 // shape:feature-prism's sharp edges, each known in closed form (the edges of ShapeMesh): the share of each
 // within 0.1 mean edge length of a mesh edge (evaluate's feature recall, per edge). The concave edge (at the
 // L's inner corner), the chamfer's short top and bottom edges between two close corners and the two top and
-// bottom edges meeting at 20° at the spike are traced; so is part of the spike's vertical edge, where the
+// bottom edges meeting at 20° at the spike are traced; so is most of the spike's vertical edge, where the
 // solid is thinner than a spacing (0.35 × the distance from it) — and only there the mesh has defects
 // (non-manifold and boundary edges: the thin-feature limit, docs/thin-mesh.md "Known limits"). How much of
-// the spike's edge is traced depends on the draw: over sample-seeds --seed 1-8, 0.19-0.90 (mean 0.63; this
-// test's --seed 1 gives the least, where thin-mesh's small-component step removes the strips beside the
-// edge); with the paper's curve step and no chain filling, 0.24-0.98 (mean 0.58). So does the share of the
-// concave corner's edges towards the spike: over --seed 1-6, 0.87-0.97 (0.83-0.98 with three pool layers).
+// the spike's edge is traced depends on the draw: over sample-seeds --seed 1-8, 0.92-1.0 (with 50 L-BFGS
+// iterations per repulsion round, before 2026-12-08: 0.19-0.90, mean 0.63; with the paper's curve step and
+// no chain filling, 0.24-0.98). So does the share of the concave corner's edges towards the spike: over
+// --seed 1-6, 0.85-0.96 (0.87-0.97 with 50 L-BFGS iterations).
 TEST_F(ChainTest, FeaturePrismTracesItsConcaveShortAndNarrowEdges) {
   if (!HaveOptimizer()) GTEST_SKIP() << "optimize-seeds is not built";
   const Chain c = RunChain(dir_, "feature-prism", 2500, 0.0, true);
@@ -335,11 +335,11 @@ TEST_F(ChainTest, FeaturePrismTracesItsConcaveShortAndNarrowEdges) {
     if (i != spike) {
       EXPECT_GE(vertical, 0.95) << "vertical edge " << i;
     }
-    EXPECT_GE(std::min(bottom, top), i + 1 == spike ? 0.85 : i == chamfer || i + 1 > spike ? 0.9 : 0.95)
+    EXPECT_GE(std::min(bottom, top), i + 1 == spike ? 0.8 : i == chamfer || i + 1 > spike ? 0.9 : 0.95)
         << "edges " << i << "-" << j;
   }
   EXPECT_GE(traced(concave, n + concave), 0.95) << "the concave edge";
-  EXPECT_GE(traced(spike, n + spike), 0.15) << "the spike's edge";
+  EXPECT_GE(traced(spike, n + spike), 0.8) << "the spike's edge";
 }
 
 // Robustness (docs/thin-mesh.md "Known limits"): of 12 sphere-disc runs (1k-3k seeds, several --seed), 10

@@ -32,7 +32,7 @@ int main(int argc, char** argv) {
   app.add_option("--delta", o.delta, "inner loop stops when the projected gradient changes by less than this");
   app.add_option("--max-outer-iters", o.max_outer_iters, "cap on outer iterations (L1 step + repulsion)");
   app.add_option("--max-inner-iters", o.max_inner_iters, "cap on repulsion rounds per outer iteration");
-  app.add_option("--lbfgs-max-iters", o.lbfgs_max_iters, "L-BFGS iterations per repulsion round");
+  app.add_option("--lbfgs-max-iters", o.lbfgs_max_iters, "L-BFGS iterations per repulsion round (few: on fixed tangent planes the energy has no minimum, and a long run ends at --max-step for every seed)");
   app.add_option("--rank-threshold", o.rank_threshold, "rank(A) counts singular values above this fraction of the largest");
   app.add_option("--crease-angle-deg", o.crease_angle_deg, "a sheet cell whose normals show two planes this many degrees apart (below 2 atan(--rank-threshold)) is a crease (0: off)");
   app.add_option("--sample-planes", o.sample_planes, "gradient: a cell sample's tangent plane is its gradient's (the paper); fit: fitted to the surface points the cell's samples point at (gradient errors); auto: fit when the gradients are off those planes by more than 8 deg and more than the value errors explain");

@@ -37,7 +37,9 @@ struct OptimizeSeedsOptions {
   double delta = 1e-3;            ///< δ, inner loop stops when the gradient changes by less than this, relatively (paper: 1e-3) (--delta)
   int max_outer_iters = 3;        ///< cap on Alg. 1's outer loop (--max-outer-iters; see docs for why 3)
   int max_inner_iters = 5;        ///< cap on Alg. 1's inner loop (--max-inner-iters); 5 with sample-seeds' spread start
-  int lbfgs_max_iters = 50;       ///< L-BFGS iterations per inner round (Ceres' default) (--lbfgs-max-iters)
+  /// L-BFGS iterations per inner round (--lbfgs-max-iters). Few: the round's energy on fixed tangent planes has
+  /// no minimum, so a longer run only ends at the --max-step limit for every seed (docs: "Repulsion rounds")
+  int lbfgs_max_iters = 3;
   double rank_threshold = 0.4;    ///< τ: rank(A) = #{singular values > τ·s_1} (--rank-threshold)
   /// A rank-1 cell whose normals show two planes turned by at least this many degrees, each seen by the share
   /// of samples τ asks of a second plane at 90°, is rank 2 (SeesTwoPlanes; --crease-angle-deg; 0: the paper's test alone)
